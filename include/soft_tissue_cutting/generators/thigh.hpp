@@ -1,0 +1,19 @@
+// The paper's experiment: a short portion of the upper leg with the thighbone removed.
+#pragma once
+
+#include "soft_tissue_cutting/scene/scene.hpp"
+
+namespace stc {
+
+// A thick tube along z, inner wall = bone surface. Structured in (r, theta, z) cells, each
+// split into 6 tets with a consistent diagonal so neighbouring cells conform.
+TetMesh make_thigh_mesh(const GeneratorParams& params);
+
+// Structured box [0, size] split into cells, 6 tets per cell.
+TetMesh make_box_mesh(const GeneratorParams& params);
+
+// The built-in `thigh` scene: the mesh, bone nodes fixed, an operation region on the outer
+// wall, three loaded surface nodes in it.
+Scene make_thigh_scene(double resolution = 1.0);
+
+}  // namespace stc

@@ -1,0 +1,104 @@
+// The scene of SPEC.md section 3, as data. Loading and validation: scene_loader.hpp.
+#pragma once
+
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stc {
+
+struct Box {
+  Vec3 min = Vec3::Zero();
+  Vec3 max = Vec3::Zero();
+  bool contains(const Vec3& p) const {  // boundary included
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+};
+
+struct Sphere {
+  Vec3 center = Vec3::Zero();
+  double radius = 0;
+  bool contains(const Vec3& p) const { return (p - center).norm() <= radius; }
+};
+
+// A set of nodes: explicit 0-based indices, a box or a sphere.
+struct NodeSelector {
+  enum class Kind { kNodes, kBox, kSphere } kind = Kind::kNodes;
+  std::vector<int> nodes;
+  Box box;
+  Sphere sphere;
+  std::vector<int> select(const TetMesh& mesh) const;  // ascending, unique
+};
+
+struct Load {
+  NodeSelector where;
+  Vec3 force = Vec3::Zero();  // N, per node (`force`) or in total (`total_force`)
+  bool total = false;         // true: split evenly over the selected nodes
+};
+
+struct Material {
+  double young_modulus = 3000.0;  // Pa
+  double poisson_ratio = 0.45;
+  double density = 1000.0;  // kg/m^3
+};
+
+struct OperationRegion {
+  enum class Kind { kSphere, kBox, kAll, kNone } kind = Kind::kAll;
+  Sphere sphere;
+  Box box;
+  bool contains(const Vec3& centroid) const;
+};
+
+struct ScalpelParams {
+  double blade_length = 0.02;  // m, edge from the tip along local +x
+  double cut_pressure = 0.5;   // N
+};
+
+// A blade pose in the scene frame: origin = blade tip, local +x = cutting edge, local y =
+// blade normal.
+struct BladePose {
+  double t = 0;
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+
+struct SolverParams {
+  std::string backend = "cpu";  // "cpu" or "gl"
+  double tolerance = 1e-10;     // relative residual ||b - Ax|| / ||b||
+  int max_iterations = 2000;
+};
+
+// Parameters of the built-in generators (SPEC 3 `mesh.generator`).
+struct GeneratorParams {
+  std::string type;  // "thigh" or "box"
+  // thigh: a thick tube along z; the inner wall is the removed thighbone.
+  double inner_radius = 0.015;
+  double outer_radius = 0.06;
+  double length = 0.096;  // 8 cells of 12 mm: near-cubic cells at the default resolution
+  double resolution = 1.0;  // multiplies the number of cells along each direction
+  // box
+  Vec3 size = Vec3(0.1, 0.02, 0.02);
+  std::array<int, 3> cells = {10, 2, 2};
+};
+
+struct Scene {
+  std::string source;         // file path the scene came from, or "thigh"
+  std::string mesh_file;      // resolved path, empty when generated
+  std::optional<GeneratorParams> generator;
+  double scale = 1.0;
+  TetMesh mesh;               // loaded/generated, scaled
+  Material material;
+  std::vector<NodeSelector> fixed;
+  std::vector<Load> loads;
+  Vec3 gravity = Vec3::Zero();
+  OperationRegion operation_region;
+  ScalpelParams scalpel;
+  std::vector<BladePose> trajectory;
+  SolverParams solver;
+};
+
+}  // namespace stc

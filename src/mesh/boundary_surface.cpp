@@ -1,0 +1,87 @@
+#include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+
+#include <algorithm>
+#include <map>
+#include <unordered_map>
+
+namespace stc {
+namespace {
+
+std::uint64_t edge_key(int a, int b) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
+}
+
+struct FaceUse {
+  int tet;
+  int face;
+};
+
+}  // namespace
+
+BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
+  // Key each face by its sorted node triple; a boundary face is used by exactly one tet.
+  std::map<std::array<int, 3>, std::vector<FaceUse>> uses;
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
+                                mesh.tets[t][kTetFaces[f][2]]};
+      std::sort(key.begin(), key.end());
+      uses[key].push_back({t, f});
+    }
+  }
+  BoundarySurface surface;
+  for (const auto& [key, list] : uses) {
+    if (list.size() == 1) {
+      const Tet& tet = mesh.tets[list[0].tet];
+      const auto& lf = kTetFaces[list[0].face];
+      surface.triangles.push_back({Tri{tet[lf[0]], tet[lf[1]], tet[lf[2]]}, list[0].tet,
+                                   list[0].face, mesh.is_cut_face(list[0].tet, list[0].face)});
+    } else if (list.size() > 2) {
+      ++surface.non_manifold_faces;
+    } else {
+      // Two users of a face must wind it in opposite directions (tets on both sides).
+      const Tet& a = mesh.tets[list[0].tet];
+      const Tet& b = mesh.tets[list[1].tet];
+      const auto& fa = kTetFaces[list[0].face];
+      const auto& fb = kTetFaces[list[1].face];
+      const Tri ta = {a[fa[0]], a[fa[1]], a[fa[2]]};
+      const Tri tb = {b[fb[0]], b[fb[1]], b[fb[2]]};
+      // Same orientation iff tb is a rotation of ta.
+      bool same = false;
+      for (int r = 0; r < 3; ++r)
+        same |= (tb[0] == ta[r] && tb[1] == ta[(r + 1) % 3] && tb[2] == ta[(r + 2) % 3]);
+      if (same) ++surface.non_manifold_faces;
+    }
+  }
+  return surface;
+}
+
+std::vector<int> boundary_nodes(const BoundarySurface& surface) {
+  std::vector<int> nodes;
+  nodes.reserve(surface.triangles.size() * 3);
+  for (const auto& tri : surface.triangles) nodes.insert(nodes.end(), tri.nodes.begin(), tri.nodes.end());
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  return nodes;
+}
+
+bool is_closed_oriented_manifold(const BoundarySurface& surface) {
+  if (surface.non_manifold_faces != 0) return false;
+  // Each directed edge used once, and its reverse used once.
+  std::unordered_map<std::uint64_t, int> directed;
+  directed.reserve(surface.triangles.size() * 3);
+  for (const auto& tri : surface.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      if (++directed[edge_key(tri.nodes[e], tri.nodes[(e + 1) % 3])] > 1) return false;
+    }
+  }
+  for (const auto& [key, count] : directed) {
+    const int a = static_cast<int>(key >> 32);
+    const int b = static_cast<int>(key & 0xffffffffu);
+    if (directed.find(edge_key(b, a)) == directed.end()) return false;
+  }
+  return true;
+}
+
+}  // namespace stc

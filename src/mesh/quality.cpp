@@ -1,0 +1,56 @@
+#include "soft_tissue_cutting/mesh/quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stc {
+
+std::array<double, 6> dihedral_angles_deg(const Vec3& a, const Vec3& b, const Vec3& c,
+                                          const Vec3& d) {
+  const Vec3 p[4] = {a, b, c, d};
+  // Outward face normals (face f opposite vertex f); the dihedral angle at the edge shared
+  // by faces f and g is pi minus the angle between their outward normals.
+  Vec3 n[4];
+  for (int f = 0; f < 4; ++f) {
+    const auto& lf = kTetFaces[f];
+    n[f] = (p[lf[1]] - p[lf[0]]).cross(p[lf[2]] - p[lf[0]]);
+    const double len = n[f].norm();
+    if (len > 0) n[f] /= len;
+  }
+  std::array<double, 6> angles{};
+  int k = 0;
+  for (int f = 0; f < 4; ++f)
+    for (int g = f + 1; g < 4; ++g)
+      angles[k++] = 180.0 - std::acos(std::clamp(n[f].dot(n[g]), -1.0, 1.0)) * 180.0 / M_PI;
+  return angles;
+}
+
+MeshQuality mesh_quality(const TetMesh& mesh) {
+  MeshQuality q;
+  q.min_dihedral_deg = q.min_volume = q.min_volume_ratio = std::numeric_limits<double>::max();
+  q.max_dihedral_deg = q.max_volume = -std::numeric_limits<double>::max();
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    const Tet& tet = mesh.tets[t];
+    const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
+               &d = mesh.nodes[tet[3]];
+    for (double angle : dihedral_angles_deg(a, b, c, d)) {
+      q.min_dihedral_deg = std::min(q.min_dihedral_deg, angle);
+      q.max_dihedral_deg = std::max(q.max_dihedral_deg, angle);
+    }
+    const double v = signed_volume(a, b, c, d);
+    q.min_volume = std::min(q.min_volume, v);
+    q.max_volume = std::max(q.max_volume, v);
+    const Vec3 p[4] = {a, b, c, d};
+    double longest = 0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (p[i] - p[j]).norm());
+    // A regular tet with edge L has volume L^3 / (6 sqrt 2).
+    const double ratio = longest > 0 ? v * 6.0 * std::sqrt(2.0) / (longest * longest * longest) : 0;
+    q.min_volume_ratio = std::min(q.min_volume_ratio, ratio);
+  }
+  if (mesh.tets.empty()) q = MeshQuality{};
+  return q;
+}
+
+}  // namespace stc

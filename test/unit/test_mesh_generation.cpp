@@ -1,0 +1,121 @@
+// Mesh generation and boundary surface extraction (issue 2).
+#include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace stc {
+namespace {
+
+// Divergence theorem: V = 1/3 sum over outward triangles of (centroid . n) area, which
+// also proves outward winding (inward winding gives -V).
+double enclosed_volume(const TetMesh& mesh, const BoundarySurface& s) {
+  double v = 0;
+  for (const auto& t : s.triangles) {
+    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]], &c = mesh.nodes[t.nodes[2]];
+    v += a.dot(b.cross(c)) / 6.0;
+  }
+  return v;
+}
+
+TEST(ThighMesh, DefaultSizeNearPaper) {
+  const Scene scene = make_thigh_scene();
+  EXPECT_EQ(scene.mesh.num_tets(), 2304);
+  EXPECT_EQ(scene.mesh.num_nodes(), 576);
+  for (int t = 0; t < scene.mesh.num_tets(); ++t) EXPECT_GT(tet_volume(scene.mesh, t), 0);
+}
+
+TEST(ThighMesh, ElementQuality) {
+  const MeshQuality q = mesh_quality(make_thigh_scene().mesh);
+  std::printf("thigh: min dihedral %.2f deg, max %.2f deg, min volume ratio %.3f\n",
+              q.min_dihedral_deg, q.max_dihedral_deg, q.min_volume_ratio);
+  // Kuhn tets of a perfect cube: 45-90 deg; the graded tube cells stay close to that.
+  EXPECT_GT(q.min_dihedral_deg, 25.0);  // measured 25.6 deg: wedge-shaped cells at the bone
+  EXPECT_LT(q.max_dihedral_deg, 125.0);
+}
+
+TEST(ThighMesh, VolumeMatchesTubeWithinPolygonError) {
+  GeneratorParams g;
+  const TetMesh mesh = make_thigh_mesh(g);
+  // The tube's circular walls become regular 16-gons: the exact discrete volume is
+  // (n/2) sin(2 pi / n) (ro^2 - ri^2) L, which differs from the analytic pi (ro^2 - ri^2) L
+  // by the polygon's chord error, 1 - sin(2 pi/n) n / (2 pi) = 2.6 % for n = 16.
+  const double annulus = (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius) * g.length;
+  const int n = 16;
+  const double discrete = 0.5 * n * std::sin(2 * M_PI / n) * annulus;
+  const double analytic = M_PI * annulus;
+  EXPECT_NEAR(total_volume(mesh), discrete, 1e-12 * discrete);
+  const double chord_error = 1 - discrete / analytic;
+  EXPECT_NEAR(std::abs(total_volume(mesh) - analytic) / analytic, chord_error, 1e-9);
+  EXPECT_LT(chord_error, 0.03);
+  // Refining converges to the analytic volume at the rate of the chord error, O(1/n^2).
+  g.resolution = 2.0;
+  EXPECT_LT(std::abs(total_volume(make_thigh_mesh(g)) - analytic) / analytic, 0.007);
+}
+
+TEST(BoundarySurface, ThighIsClosedManifoldWithOutwardNormals) {
+  const TetMesh mesh = make_thigh_scene().mesh;
+  const BoundarySurface s = extract_boundary_surface(mesh);
+  EXPECT_EQ(s.non_manifold_faces, 0);
+  EXPECT_TRUE(is_closed_oriented_manifold(s));
+  // Euler characteristic of a torus-like tube surface (genus 1): V - E + F = 0.
+  const auto nodes = boundary_nodes(s);
+  const long f = static_cast<long>(s.triangles.size());
+  EXPECT_EQ(static_cast<long>(nodes.size()) - 3 * f / 2 + f, 0);
+  EXPECT_NEAR(enclosed_volume(mesh, s), total_volume(mesh), 1e-12);
+  // Every boundary triangle's normal points away from its own tet.
+  for (const auto& t : s.triangles) {
+    const Tet& tet = mesh.tets[t.tet];
+    const Vec3 inner = mesh.nodes[tet[t.face]];
+    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]], &c = mesh.nodes[t.nodes[2]];
+    EXPECT_LT((b - a).cross(c - a).dot(inner - a), 0);
+  }
+}
+
+TEST(BoundarySurface, BoxCountsAndVolume) {
+  GeneratorParams g;
+  g.size = Vec3(0.1, 0.02, 0.03);
+  g.cells = {5, 2, 3};
+  const TetMesh mesh = make_box_mesh(g);
+  EXPECT_EQ(mesh.num_tets(), 5 * 2 * 3 * 6);
+  const BoundarySurface s = extract_boundary_surface(mesh);
+  EXPECT_TRUE(is_closed_oriented_manifold(s));
+  EXPECT_EQ(s.triangles.size(), 4u * (5 * 2 + 2 * 3 + 5 * 3));  // two triangles per cell face
+  EXPECT_NEAR(total_volume(mesh), 0.1 * 0.02 * 0.03, 1e-15);
+  EXPECT_NEAR(enclosed_volume(mesh, s), 0.1 * 0.02 * 0.03, 1e-15);
+}
+
+TEST(BoundarySurface, DetectsTangledAndNonManifold) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(0.2, 0.2, 0.5)};
+  // Two tets on the same side of face (0,1,2): folded.
+  mesh.tets = {{0, 1, 2, 3}, {0, 1, 2, 4}};
+  EXPECT_EQ(extract_boundary_surface(mesh).non_manifold_faces, 1);
+  EXPECT_FALSE(is_closed_oriented_manifold(extract_boundary_surface(mesh)));
+  mesh.tets = {{0, 1, 2, 3}};
+  EXPECT_TRUE(is_closed_oriented_manifold(extract_boundary_surface(mesh)));
+}
+
+TEST(ThighScene, FixedBoneLoadsAndOperationRegion) {
+  const Scene scene = make_thigh_scene();
+  ASSERT_EQ(scene.fixed.size(), 1u);
+  EXPECT_EQ(scene.fixed[0].nodes.size(), 16u * 9u);  // inner wall nodes
+  ASSERT_EQ(scene.loads.size(), 3u);
+  int operation = 0;
+  for (int t = 0; t < scene.mesh.num_tets(); ++t) {
+    Vec3 c = Vec3::Zero();
+    for (int v : scene.mesh.tets[t]) c += scene.mesh.nodes[v] / 4.0;
+    operation += scene.operation_region.contains(c);
+  }
+  std::printf("thigh: %d operation tets, %d non-operation tets\n", operation,
+              scene.mesh.num_tets() - operation);
+  EXPECT_GT(operation, 50);
+  EXPECT_LT(operation, 600);
+}
+
+}  // namespace
+}  // namespace stc
