@@ -1,0 +1,48 @@
+// The linear solver behind the hybrid system (METHOD.md section 3, eq. 17; section 5 step 5):
+// a symmetric positive definite sparse matrix solved by Conjugate Gradient, warm-started.
+// Backends: CPU (solve/) and GPU textures through headless EGL (gpu/).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace stc {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+using Vector = Eigen::VectorXd;
+
+struct CgSettings {
+  double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (SPEC 3 solver.tolerance)
+  int max_iterations = 2000;
+};
+
+struct CgResult {
+  int iterations = 0;
+  double residual = 0;  // final relative residual ||b - A x|| / ||b|| (true residual)
+  bool converged = false;
+};
+
+// Solves A x = b with some DOFs held at the values x already has on entry (Dirichlet:
+// contact-imposed displacements, held free pieces): those DOFs have constrained[i] != 0 and
+// the solve is the projected CG on the others, i.e. A_ff x_f = b_f - A_fc x_c. An empty
+// `constrained` means none. The relative residual is measured on the free DOFs.
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  virtual std::string backend() const = 0;          // "cpu" or "gl"
+  virtual std::string renderer() const { return ""; }  // GL renderer string for "gl"
+  // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.
+  virtual void set_matrix(const SparseMatrix& a) = 0;
+  virtual CgResult solve(const Vector& b, Vector& x, const std::vector<std::uint8_t>& constrained,
+                         const CgSettings& settings) = 0;
+};
+
+// Jacobi-preconditioned CG in double precision on the CPU.
+std::unique_ptr<LinearSolver> make_cpu_solver();
+
+}  // namespace stc
