@@ -1,0 +1,33 @@
+// Per-tet element stiffness matrices, kept so that after a cut only the changed tets are
+// recomputed (METHOD.md section 5 step 4: "re-assemble only the changed elements").
+#pragma once
+
+#include "soft_tissue_cutting/assembly/element_stiffness.hpp"
+#include "soft_tissue_cutting/scene/scene.hpp"
+
+#include <vector>
+
+namespace stc {
+
+class ElementStiffnessCache {
+ public:
+  ElementStiffnessCache() = default;
+  ElementStiffnessCache(const TetMesh& mesh, const Material& material);
+
+  // The mesh changed in place: resize to its tet count and recompute the listed tets (indices
+  // of replaced or appended tets). Tets not listed keep their matrices.
+  void update(const TetMesh& mesh, const std::vector<int>& changed_tets);
+
+  // Homogeneous material: every K_e is linear in E.
+  void set_young_modulus(double young_modulus);
+
+  const Mat12& operator[](int tet) const { return matrices_[static_cast<size_t>(tet)]; }
+  int size() const { return static_cast<int>(matrices_.size()); }
+  const Material& material() const { return material_; }
+
+ private:
+  Material material_;
+  std::vector<Mat12> matrices_;
+};
+
+}  // namespace stc

@@ -1,0 +1,43 @@
+// Sparse Cholesky factorization of an SPD matrix through CHOLMOD's supernodal LL^T
+// (SuiteSparse). Used once per session for K2_NN of the condensed part (METHOD.md section 3)
+// and by the reference direct solver of the full model. The CHOLMOD headers stay inside one
+// translation unit (pimpl).
+#pragma once
+
+#include "soft_tissue_cutting/solve/linear_solver.hpp"  // SparseMatrix, Vector
+
+#include <Eigen/Core>
+
+#include <memory>
+
+namespace stc {
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  // Throws std::runtime_error if the matrix is not positive definite (e.g. a piece of the
+  // mesh with no fixed node and no interface to hold it).
+  explicit SparseCholesky(const SparseMatrix& a);
+
+  // X = A^-1 B for all columns of B in one CHOLMOD call.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  Vector solve(const Vector& b) const;
+  int rows() const { return rows_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int rows_ = 0;
+};
+
+// The reference direct solve of the general (uncondensed) model, for tests:
+// K_ff u_f = f_f - K_fc u_c where constrained DOFs (constrained[i] != 0) take their value from
+// x on entry; the result overwrites x.
+void solve_direct(const SparseMatrix& a, const Vector& b, Vector& x,
+                  const std::vector<std::uint8_t>& constrained = {});
+
+}  // namespace stc

@@ -1,0 +1,30 @@
+#include "soft_tissue_cutting/assembly/element_cache.hpp"
+
+namespace stc {
+namespace {
+
+Mat12 stiffness_of(const TetMesh& mesh, int t, const Material& m) {
+  const Tet& e = mesh.tets[static_cast<size_t>(t)];
+  return element_stiffness(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                           mesh.nodes[e[3]], m.young_modulus, m.poisson_ratio);
+}
+
+}  // namespace
+
+ElementStiffnessCache::ElementStiffnessCache(const TetMesh& mesh, const Material& material)
+    : material_(material), matrices_(mesh.tets.size()) {
+  for (int t = 0; t < mesh.num_tets(); ++t) matrices_[t] = stiffness_of(mesh, t, material_);
+}
+
+void ElementStiffnessCache::update(const TetMesh& mesh, const std::vector<int>& changed_tets) {
+  matrices_.resize(mesh.tets.size());
+  for (int t : changed_tets) matrices_[static_cast<size_t>(t)] = stiffness_of(mesh, t, material_);
+}
+
+void ElementStiffnessCache::set_young_modulus(double young_modulus) {
+  const double s = young_modulus / material_.young_modulus;
+  for (Mat12& k : matrices_) k *= s;
+  material_.young_modulus = young_modulus;
+}
+
+}  // namespace stc

@@ -1,0 +1,73 @@
+#include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include <stdexcept>
+
+namespace stc {
+
+// Eigen's wrapper drives CHOLMOD directly: cholmod_analyze + cholmod_factorize with
+// supernodal = CHOLMOD_SUPERNODAL, and cholmod_solve on a whole dense block of right-hand
+// sides at once.
+struct SparseCholesky::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>
+      llt;
+};
+
+SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
+SparseCholesky::~SparseCholesky() = default;
+
+SparseCholesky::SparseCholesky(const SparseMatrix& a)
+    : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
+  if (rows_ == 0) return;
+  const Eigen::SparseMatrix<double, Eigen::ColMajor, int> col(a);
+  impl_->llt.compute(col);
+  if (impl_->llt.info() != Eigen::Success)
+    throw std::runtime_error(
+        "sparse Cholesky (CHOLMOD): matrix not positive definite - a part of the mesh is "
+        "neither fixed nor held by the interface");
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
+  if (rows_ == 0 || b.cols() == 0) return Eigen::MatrixXd::Zero(rows_, b.cols());
+  Eigen::MatrixXd x = impl_->llt.solve(b);
+  return x;
+}
+
+Vector SparseCholesky::solve(const Vector& b) const {
+  if (rows_ == 0) return Vector::Zero(0);
+  Vector x = impl_->llt.solve(b);
+  return x;
+}
+
+void solve_direct(const SparseMatrix& a, const Vector& b, Vector& x,
+                  const std::vector<std::uint8_t>& constrained) {
+  const int n = static_cast<int>(a.rows());
+  if (x.size() != n) x = Vector::Zero(n);
+  std::vector<int> free_of(static_cast<size_t>(n), -1);
+  std::vector<int> free;
+  for (int i = 0; i < n; ++i)
+    if (constrained.empty() || !constrained[static_cast<size_t>(i)]) {
+      free_of[static_cast<size_t>(i)] = static_cast<int>(free.size());
+      free.push_back(i);
+    }
+  Vector xc = x;
+  for (int i : free) xc[i] = 0;
+  const Vector rhs_all = b - a * xc;
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (int r = 0; r < n; ++r) {
+    if (free_of[static_cast<size_t>(r)] < 0) continue;
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
+      if (free_of[static_cast<size_t>(it.col())] >= 0)
+        t.emplace_back(free_of[static_cast<size_t>(r)], free_of[static_cast<size_t>(it.col())],
+                       it.value());
+  }
+  SparseMatrix aff(static_cast<int>(free.size()), static_cast<int>(free.size()));
+  aff.setFromTriplets(t.begin(), t.end());
+  Vector rhs(static_cast<int>(free.size()));
+  for (size_t k = 0; k < free.size(); ++k) rhs[static_cast<int>(k)] = rhs_all[free[k]];
+  const Vector xf = SparseCholesky(aff).solve(rhs);
+  for (size_t k = 0; k < free.size(); ++k) x[free[k]] = xf[static_cast<int>(k)];
+}
+
+}  // namespace stc
