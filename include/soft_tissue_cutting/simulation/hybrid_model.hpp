@@ -1,0 +1,129 @@
+// The hybrid condensed finite element model (METHOD.md sections 2-4): the operation part
+// (part 1) stays a sparse FE model that cutting may change; the non-operation part (part 2) is
+// condensed once onto the interface. Each step solves eq. 17 over the free DOFs of O u I,
+//   [K1_OO  K1_OI     ] [u_O]   [f_O     ]
+//   [K1_IO  K1_II + K0] [u_I] = [f_I - g0]
+// with the injectable LinearSolver (projected CG, warm-started), then recovers u_S = c_S + R u_I.
+// ROS-free; the Simulation facade drives it.
+#pragma once
+
+#include "soft_tissue_cutting/assembly/element_cache.hpp"
+#include "soft_tissue_cutting/condensation/condensed_part.hpp"
+#include "soft_tissue_cutting/partition/partition.hpp"
+#include "soft_tissue_cutting/recovery/surface_recovery.hpp"
+#include "soft_tissue_cutting/scene/scene.hpp"
+#include "soft_tissue_cutting/solve/linear_solver.hpp"
+
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace stc {
+
+// Imposed displacements: node -> displacement (scalpel contact, held free pieces).
+using ImposedDisplacements = std::map<int, Vec3>;
+
+// A node appended by the cutting stage; its displacement starts as sum_k w_k u(parent_k)
+// (e.g. the midpoint of a split edge: parents {a, b}, weights {0.5, 0.5}; a duplicated node
+// along a cut: one parent, weight 1).
+struct NewNode {
+  std::vector<int> parents;
+  std::vector<double> weights;
+};
+
+// Sizes for the stats (SPEC section 4); fixed nodes count in their set.
+struct HybridModelCounts {
+  int nodes = 0, tets = 0;
+  int dof_operation = 0;  // rows of the hybrid system: free DOFs of O u I
+  int nodes_operation = 0, nodes_interface = 0, nodes_surface_condensed = 0,
+      nodes_interior_condensed = 0;
+};
+
+class HybridModel {
+ public:
+  // Partition, element matrices, condensation (CHOLMOD), recovery operator, hybrid matrix.
+  // Throws std::runtime_error if part 2 cannot be condensed (singular K2_NN).
+  explicit HybridModel(const Scene& scene,
+                       std::unique_ptr<LinearSolver> solver = make_cpu_solver());
+  ~HybridModel();
+  HybridModel(const HybridModel&) = delete;
+  HybridModel& operator=(const HybridModel&) = delete;
+
+  // One quasi-static step: the imposed DOFs become constrained DOFs of the projected CG, warm
+  // started from the current displacement; then u_S is recovered. Imposed nodes must be O or
+  // I nodes (std::invalid_argument otherwise); imposed components on fixed nodes are ignored.
+  CgResult solve(const ImposedDisplacements& imposed = {});
+
+  // Sum over `nodes` of (K u - f) of the whole model at the current solution: the force the
+  // imposing body (blade, holder) must apply to the tissue; the tissue pushes back on it with
+  // the negative. On O and I nodes this is the hybrid residual (for I nodes K0 u_I + g0 is
+  // exactly part 2's K2_II u_I + K2_IN u_N - f2_I). Fixed DOFs and S/Q nodes contribute 0.
+  Vec3 reaction_force(const std::vector<int>& nodes) const;
+
+  // 3n displacement. O, I, S are current after solve(); Q after recover_interior().
+  const Vector& displacement() const { return u_; }
+  void recover_interior();
+
+  // Cutting hook: the operation part of mesh_for_cutting() was changed in place (tets
+  // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
+  // (all become operation tets); new_nodes: one entry per appended node, in order (all become
+  // O nodes, free, unloaded). Only the changed element matrices are recomputed; K0, g0, R,
+  // c_S are untouched. Consistent gravity of the changed tets is re-lumped.
+  void update_operation_part(const std::vector<int>& changed_tets,
+                             const std::vector<NewNode>& new_nodes);
+  TetMesh& mesh_for_cutting() { return mesh_; }
+
+  // Homogeneous material: K1 and K0 scale with E, c_S with 1/E, g0 and R are unchanged
+  // (K2_NN^-1 K2_NI and K2_IN K2_NN^-1 f_N are ratios), no refactorization.
+  void set_young_modulus(double young_modulus);
+
+  void set_solver(std::unique_ptr<LinearSolver> solver);
+  const LinearSolver& solver() const { return *solver_; }
+  void set_cg_settings(const CgSettings& settings) { settings_ = settings; }
+  const CgSettings& cg_settings() const { return settings_; }
+
+  const TetMesh& mesh() const { return mesh_; }
+  const Partition& partition() const { return partition_; }
+  const Material& material() const { return elements_.material(); }
+  HybridModelCounts counts() const;
+  const CgResult& last_result() const { return last_; }
+  // Precompute stages in ms: partition, element_stiffness, condensation_assembly,
+  // condensation_factor, condensation_solve, condensation_products, recovery_operator,
+  // hybrid_assembly, total.
+  const std::map<std::string, double>& precompute_timings_ms() const { return timings_; }
+
+  // The assembled eq. 17 system and its DOF numbering (for tests and GPU backends).
+  const SparseMatrix& hybrid_matrix() const { return a_; }
+  const Vector& hybrid_rhs() const { return b_; }
+  const DofMap& hybrid_dofs() const { return dofs_; }
+  // Global load vector (3n): point loads + consistent gravity of the current mesh.
+  Vector loads() const;
+  const std::vector<std::uint8_t>& fixed_nodes() const { return fixed_; }
+
+ private:
+  void rebuild_hybrid_system();
+  void recover_surface();
+
+  TetMesh mesh_;
+  Vec3 gravity_ = Vec3::Zero();
+  Vector point_loads_;                  // 3n, new nodes unloaded
+  std::vector<std::uint8_t> fixed_;     // per node
+  ElementStiffnessCache elements_;
+  Partition partition_;
+  CondensedPart condensed_;
+  SurfaceRecovery recovery_;
+  double condensed_scale_ = 1.0;        // E now / E at condensation time
+  DofMap dofs_;                         // hybrid system over free DOFs of O u I
+  std::vector<int> interface_row_;      // free interface DOF k -> hybrid row
+  SparseMatrix a_;
+  Vector b_;
+  Vector u_;
+  std::unique_ptr<LinearSolver> solver_;
+  CgSettings settings_;
+  CgResult last_;
+  std::map<std::string, double> timings_;
+};
+
+}  // namespace stc
