@@ -1,0 +1,51 @@
+// What one cut did to the mesh, so the simulation can update its own per-node and per-tet
+// state (displacements, fixed flags, K^(1)) incrementally.
+#pragma once
+
+#include <vector>
+
+namespace stc {
+
+// A node appended by a cut. Process CutResult::new_nodes in order: a duplicate's parent may
+// itself be a node added earlier in the same list.
+struct NewNode {
+  enum class Kind {
+    kEdgeSplit,  // on edge (a, b) at parameter t: initialise u = (1 - t) u_a + t u_b
+    kDuplicate,  // a copy of a (a node separated by the cut): initialise u = u_a, copy flags
+  };
+  int index = -1;
+  Kind kind = Kind::kEdgeSplit;
+  int a = -1;
+  int b = -1;  // kEdgeSplit only
+  double t = 0;
+};
+
+struct CutOptions {
+  // A node whose distance to the cut plane is below snap_tolerance times the LONGEST edge
+  // at the node counts as on the plane (it is never moved). Relative to the longest edge,
+  // every edge that is split has its crossing parameter t in [snap, 1 - snap] (|d_a| >=
+  // snap L_ab and |d_a - d_b| <= L_ab), so each bisection child keeps at least `snap` of
+  // its parent's volume. The price: the cut surface may lie up to snap * h off the blade.
+  double snap_tolerance = 0.1;
+  // No split may leave a tet below this fraction of its size class (the volume of the input
+  // tet it descends from). A split that would is refused by snapping its nearer end instead;
+  // SPEC 6's "small fraction" is this number. With snap 0.1 a tet can be cut through twice
+  // (0.1^2 = 0.01) before the guard changes any cut.
+  double min_volume_fraction = 0.01;
+  // Barycentric slack of "inside the sweep triangle" (crossing points and face centroids),
+  // so a cut along a triangle's border and consecutive sweeps leave no gap.
+  double inside_tolerance = 1e-9;
+};
+
+struct CutResult {
+  // Tets whose node list changed or that were appended, ascending, unique. Split tets keep
+  // their index for the first child; the other children are appended.
+  std::vector<int> changed_tets;
+  std::vector<NewNode> new_nodes;
+  int tets_split = 0;        // parent tets bisected (a tet split twice counts twice)
+  int nodes_added = 0;       // edge nodes + duplicates
+  int cut_faces_added = 0;   // net new cut faces (each face once; a halved one counts 1 more)
+  bool reached_interface = false;  // cut faces dropped so a locked node stays whole
+};
+
+}  // namespace stc

@@ -1,0 +1,36 @@
+// What the cutter keeps beside the TetMesh between cuts, index-aligned with it. Every cutting
+// function takes (TetMesh&, CutState&) and grows both together.
+#pragma once
+
+#include "soft_tissue_cutting/cutting/tet_grid.hpp"
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace stc {
+
+struct CutState {
+  // Per node: never duplicated by a cut (the interface to the condensed part). Nodes of
+  // non-cuttable tets are always locked (make_cut_state enforces it), so "an edge with both
+  // ends locked is never split" also keeps every edge of a non-cuttable tet whole.
+  std::vector<std::uint8_t> locked;
+  // Per tet: part of the operation part; only these are split, cut or separated.
+  std::vector<std::uint8_t> cuttable;
+  // Per tet: the volume of the original input tet it descends from (its "size class", SPEC 6).
+  std::vector<double> origin_volume;
+  // Per node: the tets that use it (kept up to date by every edit).
+  std::vector<std::vector<int>> node_tets;
+  // Cuttable tets by rest-position box.
+  TetGrid grid;
+};
+
+// locked: per node (empty = none); cuttable: per tet (empty = all). Also sizes
+// mesh.cut_faces to one entry per tet.
+CutState make_cut_state(TetMesh& mesh, std::vector<std::uint8_t> locked,
+                        std::vector<std::uint8_t> cuttable);
+
+// The tets that use both a and b, ascending.
+std::vector<int> tets_with_edge(const CutState& state, int a, int b);
+
+}  // namespace stc

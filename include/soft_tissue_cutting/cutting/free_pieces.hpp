@@ -1,0 +1,28 @@
+// Pieces of tissue a cut has severed from everything that holds the body in place.
+//
+// Policy the simulation applies (SPEC 6: "neither breaks the solver nor disappears
+// silently"): a free piece is KEPT in the mesh and HELD at its current displacement - its
+// nodes are treated as fixed (Dirichlet, value = their displacement when it came free) from
+// then on, so K stays positive definite on the remaining free DOF and the piece stays visible
+// where it was. It is never removed and never left singular; the simulation reports it.
+#pragma once
+
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+#include <vector>
+
+namespace stc {
+
+struct MeshPiece {
+  std::vector<int> tets;   // ascending
+  std::vector<int> nodes;  // ascending
+};
+
+// Connected components of the mesh, tets connected when they share a node (a shared face
+// or edge implies a shared node), in order of their smallest tet.
+std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh);
+
+// The components with no anchored node (anchored: per node, e.g. fixed or interface nodes).
+std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored);
+
+}  // namespace stc

@@ -1,0 +1,36 @@
+// A uniform grid over the rest-position bounding boxes of tets, so a sweep finds the tets it
+// may meet without scanning the mesh.
+//
+// Why the grid only ever grows: rest positions never move, and a bisected tet's children lie
+// inside the parent's box. A child that keeps its parent's index is therefore still listed in
+// (a superset of) its cells, and appended tets are inserted. Queries filter by the exact box.
+#pragma once
+
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+#include <vector>
+
+namespace stc {
+
+class TetGrid {
+ public:
+  // Grid over the tets with include[t] != 0 (all tets when include is empty).
+  void build(const TetMesh& mesh, const std::vector<std::uint8_t>& include);
+  void insert(const TetMesh& mesh, int tet);
+  // Listed tets whose box overlaps [lo, hi], ascending and unique.
+  std::vector<int> query(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const;
+
+ private:
+  std::array<int, 3> cell_of(const Vec3& p) const;
+  Vec3 origin_ = Vec3::Zero();
+  double cell_size_ = 1.0;
+  std::array<int, 3> dims_ = {1, 1, 1};
+  std::vector<std::vector<int>> cells_;
+  mutable std::vector<unsigned> seen_;  // per tet: query stamp, to report each tet once
+  mutable unsigned stamp_ = 0;
+};
+
+// Rest-position bounding box of a tet.
+void tet_bounds(const TetMesh& mesh, int tet, Vec3& lo, Vec3& hi);
+
+}  // namespace stc

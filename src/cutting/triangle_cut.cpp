@@ -1,0 +1,218 @@
+#include "soft_tissue_cutting/cutting/triangle_cut.hpp"
+
+#include "soft_tissue_cutting/cutting/edge_bisection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_map>
+
+namespace stc {
+namespace {
+
+// The six edges of a tet as local vertex pairs.
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+struct PlanarTriangle {
+  Vec3 a, b, c, normal;  // unit normal
+  double double_area = 0;
+  // Is the projection of p onto the plane inside the triangle, with barycentric slack tol?
+  bool contains(const Vec3& p, double tol) const {
+    const Vec3 q = p - normal * normal.dot(p - a);
+    const double u = normal.dot((b - q).cross(c - q)) / double_area;
+    const double v = normal.dot((c - q).cross(a - q)) / double_area;
+    const double w = 1.0 - u - v;
+    return u >= -tol && v >= -tol && w >= -tol;
+  }
+};
+
+struct Split {
+  int a, b;  // a < b
+  double t;  // crossing at x_a + t (x_b - x_a)
+};
+
+// Volume of the smallest piece tet `nodes` falls into when the crossing edges in `splits`
+// are bisected in that order (the order insert_cut_triangle applies them in). Each piece
+// containing an edge being split is bisected, exactly as bisect_edge does.
+double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
+  struct Piece {
+    std::array<int, 4> id;
+    std::array<Vec3, 4> x;
+  };
+  std::vector<Piece> pieces(1);
+  for (int k = 0; k < 4; ++k) {
+    pieces[0].id[k] = nodes[k];
+    pieces[0].x[k] = mesh.nodes[nodes[k]];
+  }
+  int next_virtual = -1;
+  for (const Split& s : splits) {
+    const Vec3 m = mesh.nodes[s.a] + s.t * (mesh.nodes[s.b] - mesh.nodes[s.a]);
+    const int mid = next_virtual--;
+    const size_t count = pieces.size();
+    for (size_t p = 0; p < count; ++p) {
+      auto ia = std::find(pieces[p].id.begin(), pieces[p].id.end(), s.a) - pieces[p].id.begin();
+      auto ib = std::find(pieces[p].id.begin(), pieces[p].id.end(), s.b) - pieces[p].id.begin();
+      if (ia == 4 || ib == 4) continue;
+      Piece other = pieces[p];
+      pieces[p].id[ib] = mid;
+      pieces[p].x[ib] = m;
+      other.id[ia] = mid;
+      other.x[ia] = m;
+      pieces.push_back(other);
+    }
+  }
+  double smallest = 1e300;
+  for (const Piece& p : pieces)
+    smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
+  return smallest;
+}
+
+}  // namespace
+
+std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet, int face) {
+  const Tet& t = mesh.tets[tet];
+  const int p = t[kTetFaces[face][0]], q = t[kTetFaces[face][1]], r = t[kTetFaces[face][2]];
+  for (int other : state.node_tets[p]) {
+    if (other == tet) continue;
+    const Tet& o = mesh.tets[other];
+    int fourth = -1, hits = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (o[k] == p || o[k] == q || o[k] == r)
+        ++hits;
+      else
+        fourth = k;
+    }
+    if (hits == 3) return {other, fourth};
+  }
+  return {-1, -1};
+}
+
+void insert_cut_triangle(TetMesh& mesh, CutState& state, const Vec3& a, const Vec3& b,
+                         const Vec3& c, const CutOptions& options, CutResult& result,
+                         std::set<FaceKey>& new_faces) {
+  PlanarTriangle tri{a, b, c, (b - a).cross(c - a), 0};
+  tri.double_area = tri.normal.norm();
+  const double diameter = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  if (!(tri.double_area > 1e-12 * diameter * diameter)) return;  // a plunge sweeps no area
+  tri.normal /= tri.double_area;
+  const double tol = options.inside_tolerance;
+
+  // Every tet with a crossing edge inside the triangle, or a face on it, overlaps this box.
+  const Vec3 pad = Vec3::Constant(1e-6 * diameter);
+  const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - pad, hi = a.cwiseMax(b).cwiseMax(c) + pad;
+  std::vector<int> candidates;
+  for (int t : state.grid.query(mesh, lo, hi))
+    if (state.cuttable[t]) candidates.push_back(t);
+  if (candidates.empty()) return;
+
+  // (a) Signed distances and sides: -1, +1, or 0 = on the cut (snapped, never moved).
+  std::unordered_map<int, double> distance;
+  std::unordered_map<int, int> side;
+  auto classify = [&](int v) {
+    auto it = side.find(v);
+    if (it != side.end()) return it->second;
+    const double d = tri.normal.dot(mesh.nodes[v] - a);
+    double longest = 0;
+    for (int t : state.node_tets[v])
+      for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
+    const int s = std::abs(d) < options.snap_tolerance * longest ? 0 : (d > 0 ? 1 : -1);
+    distance[v] = d;
+    side[v] = s;
+    return s;
+  };
+  for (int t : candidates)
+    for (int v : mesh.tets[t]) classify(v);
+
+  // (b) Crossing edges inside the triangle. The volume guard may snap an end to "on", which
+  // only removes crossing edges, so the loop ends.
+  std::map<std::pair<int, int>, double> crossing;
+  for (;;) {
+    crossing.clear();
+    for (int t : candidates) {
+      const Tet& tet = mesh.tets[t];
+      for (const auto& e : kTetEdges) {
+        int u = tet[e[0]], v = tet[e[1]];
+        if (side[u] * side[v] != -1) continue;
+        if (u > v) std::swap(u, v);
+        if (crossing.count({u, v})) continue;
+        if (state.locked[u] && state.locked[v]) continue;  // interface edges stay whole
+        const double du = distance[u], dv = distance[v];
+        const double s = du / (du - dv);
+        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), tol)) continue;
+        crossing[{u, v}] = s;
+      }
+    }
+    bool snapped = false;
+    for (int t : candidates) {
+      std::vector<Split> splits;
+      const Tet& tet = mesh.tets[t];
+      for (const auto& e : kTetEdges) {
+        const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
+        auto it = crossing.find({u, v});
+        if (it != crossing.end()) splits.push_back({u, v, it->second});
+      }
+      if (splits.empty()) continue;
+      std::sort(splits.begin(), splits.end(),
+                [](const Split& x, const Split& y) { return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b); });
+      if (smallest_piece(mesh, tet, splits) >= options.min_volume_fraction * state.origin_volume[t])
+        continue;
+      // Snap the end nearest the plane among this tet's crossing edges.
+      int nearest = -1;
+      double best = 2.0;
+      for (const Split& s : splits) {
+        if (s.t < best) best = s.t, nearest = s.a;
+        if (1 - s.t < best) best = 1 - s.t, nearest = s.b;
+      }
+      side[nearest] = 0;
+      snapped = true;
+    }
+    if (!snapped) break;
+  }
+
+  const int tets_before_splits = mesh.num_tets();
+  // Bisect in (a, b) order, so each tet is cut into exactly the pieces the guard checked.
+  for (const auto& [edge, t] : crossing) {
+    const size_t before = result.changed_tets.size();
+    const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
+    result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
+    side[m] = 0;
+    distance[m] = 0;
+    NewNode node;
+    node.index = m;
+    node.kind = NewNode::Kind::kEdgeSplit;
+    node.a = edge.first;
+    node.b = edge.second;
+    node.t = t;
+    result.new_nodes.push_back(node);
+  }
+  // The appended children are candidates too.
+  for (int t = tets_before_splits; t < mesh.num_tets(); ++t) candidates.push_back(t);
+
+  // (c) Faces on the cut: three "on" nodes, centroid inside the triangle, tets on opposite
+  // sides. Both tets get the face's bit.
+  for (int t : candidates) {
+    for (int f = 0; f < 4; ++f) {
+      if (mesh.is_cut_face(t, f)) continue;
+      const Tet& tet = mesh.tets[t];
+      const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
+      if (classify(p) != 0 || classify(q) != 0 || classify(r) != 0) continue;
+      const int here = classify(tet[f]);
+      if (here == 0) continue;
+      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+      if (other < 0) continue;
+      if (classify(mesh.tets[other][other_face]) != -here) continue;
+      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0, tol)) continue;
+      if (!state.cuttable[other]) {  // the blade stops at the condensed part
+        result.reached_interface = true;
+        continue;
+      }
+      mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
+      mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
+      FaceKey key = {p, q, r};
+      std::sort(key.begin(), key.end());
+      new_faces.insert(key);
+    }
+  }
+}
+
+}  // namespace stc
