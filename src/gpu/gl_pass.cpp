@@ -58,6 +58,11 @@ void PassRunner::set(const char* name, float v) {
   if (loc >= 0) glUniform1f(loc, v);
 }
 
+void PassRunner::set(const char* name, int x, int y) {
+  const int loc = shaders_.uniform(program_, name);
+  if (loc >= 0) glUniform2i(loc, x, y);
+}
+
 void PassRunner::draw(const Texture& target) {
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer());
   const GLenum buf = GL_COLOR_ATTACHMENT0;

@@ -29,6 +29,7 @@ class PassRunner {
   void rebind(int unit, const Texture& t);
   void set(const char* name, int v);
   void set(const char* name, float v);
+  void set(const char* name, int x, int y);  // ivec2
   // Draws the quad over the whole of `target` (all targets must have the same size).
   void draw(const Texture& target);
   void draw(std::initializer_list<const Texture*> targets);
