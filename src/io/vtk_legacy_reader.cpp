@@ -80,7 +80,7 @@ class VtkLegacyReader {
         tet[k] = static_cast<int>(v);
       }
       out_.mesh.tets.push_back(tet);
-      out_.lines.tet_line.push_back(binary_ ? cells_line_ : cell_lines_[i]);
+      out_.lines.tet_line.push_back(i < cell_lines_.size() ? cell_lines_[i] : cells_line_);
     }
     return std::move(out_);
   }

@@ -137,7 +137,7 @@ RawMesh read_vtu(const std::string& path, const std::string& data) {
   long long num_points = -1, num_cells = -1;
   int piece_line = 0;
   Array points, connectivity, offsets, types;
-  std::vector<std::string> stack;
+  std::vector<std::string> stack = {"VTKFile"};
   while (xml.next(tag)) {
     if (tag.closing) {
       if (stack.empty() || stack.back() != tag.name)
