@@ -65,6 +65,8 @@ class HybridModel {
   // 3n displacement. O, I, S are current after solve(); Q after recover_interior().
   const Vector& displacement() const { return u_; }
   void recover_interior();
+  // Zero displacement everywhere (the next solve starts cold).
+  void reset_displacement() { u_.setZero(); }
 
   // Cutting hook: the operation part of mesh_for_cutting() was changed in place (tets
   // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
