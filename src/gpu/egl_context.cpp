@@ -19,18 +19,27 @@ namespace {
 
 // EGL displays are process-wide singletons per (platform, device): eglTerminate would kill
 // every other solver's context on the same display, so terminate only with the last user.
-std::mutex g_display_mutex;
-std::map<EGLDisplay, int> g_display_users;
+// Function-local statics: contexts may be created during static initialisation (benchmark
+// registration), before namespace-scope globals of this file are constructed.
+std::mutex& display_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+std::map<EGLDisplay, int>& display_users() {
+  static std::map<EGLDisplay, int> users;
+  return users;
+}
 
 void retain_display(EGLDisplay d) {
-  std::lock_guard<std::mutex> lock(g_display_mutex);
-  ++g_display_users[d];
+  std::lock_guard<std::mutex> lock(display_mutex());
+  ++display_users()[d];
 }
 
 void release_display(EGLDisplay d) {
-  std::lock_guard<std::mutex> lock(g_display_mutex);
-  if (--g_display_users[d] == 0) {
-    g_display_users.erase(d);
+  std::lock_guard<std::mutex> lock(display_mutex());
+  if (--display_users()[d] == 0) {
+    display_users().erase(d);
     eglTerminate(d);
   }
 }

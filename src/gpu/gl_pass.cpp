@@ -22,6 +22,8 @@ PassRunner::~PassRunner() {
   glDeleteVertexArrays(1, &vao_);
 }
 
+void PassRunner::finish() { glFinish(); }
+
 void PassRunner::clear_framebuffers() {
   for (auto& f : mrt_fbos_) glDeleteFramebuffers(1, &f.second);
   mrt_fbos_.clear();

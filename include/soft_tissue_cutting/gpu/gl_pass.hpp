@@ -35,6 +35,8 @@ class PassRunner {
   void draw(std::initializer_list<const Texture*> targets);
 
   long passes() const { return passes_; }
+  // Waits until every queued pass has run (glFinish): for timings only.
+  void finish();
   // Forget multi-target framebuffers (call before textures they use are reallocated).
   void clear_framebuffers();
   ShaderLibrary& shaders() { return shaders_; }
