@@ -18,23 +18,40 @@ long count_marked_face_sides(const TetMesh& mesh) {
 
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
-                        const CutOptions& options) {
+                        const CutOptions& options,
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in) {
   CutResult result;
   std::set<FaceKey> new_faces;
   const long marked_before = count_marked_face_sides(mesh);
+  std::vector<TriangleClassification> cut;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (const auto& tri : triangles) {
-    insert_cut_triangle(mesh, state, tri[0], tri[1], tri[2], options, result, new_faces);
-    for (const Vec3& p : tri) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
+    cut.emplace_back(tri[0], tri[1], tri[2], options.snap_tolerance);
+    Vec3 a, b;
+    cut.back().bounds(a, b);
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+  }
+  // All splits first, then all marks (triangle_cut.hpp says why).
+  for (auto& tri : cut) split_along_triangle(mesh, state, tri, options, result);
+  for (auto& tri : cut) {
+    Vec3 a, b;
+    tri.bounds(a, b);
+    mark_faces_on_triangle(mesh, state, tri, a, b, options, result, new_faces);
+  }
+  // The previous sweep's triangles, only where they overlap this cut's box.
+  for (const auto& tri : also_mark_in) {
+    TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
+    if (previous.degenerate()) continue;
+    Vec3 a, b;
+    previous.bounds(a, b);
+    mark_faces_on_triangle(mesh, state, previous, a.cwiseMax(lo), b.cwiseMin(hi), options, result,
+                           new_faces);
   }
   if (!triangles.empty()) {
     // Marked faces lie inside the triangles' box; their tets overlap it.
-    const Vec3 pad = Vec3::Constant(1e-6 * (hi - lo).norm());
     std::vector<int> region;
-    for (int t : state.grid.query(mesh, lo - pad, hi + pad))
+    for (int t : state.grid.query(mesh, lo, hi))
       if (state.cuttable[t]) region.push_back(t);
     separate_along_cuts(mesh, state, region, result, new_faces);
   }
@@ -50,8 +67,16 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
 
 CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const BladeEdge& to,
                     const CutOptions& options) {
-  return cut_triangles(mesh, state,
-                       {{from.tip, from.heel, to.heel}, {from.tip, to.heel, to.tip}}, options);
+  const double scale = std::max((from.heel - from.tip).norm(), (to.tip - from.tip).norm());
+  const bool continues = (from.tip - state.last_sweep_end[0]).norm() <= 1e-9 * scale &&
+                         (from.heel - state.last_sweep_end[1]).norm() <= 1e-9 * scale;
+  const std::vector<std::array<Vec3, 3>> sweep = {{from.tip, from.heel, to.heel},
+                                                  {from.tip, to.heel, to.tip}};
+  const std::vector<std::array<Vec3, 3>> none;
+  CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
+  state.last_sweep = sweep;
+  state.last_sweep_end = {to.tip, to.heel};
+  return result;
 }
 
 }  // namespace stc

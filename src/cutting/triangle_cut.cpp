@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <unordered_map>
 
 namespace stc {
 namespace {
@@ -13,26 +12,13 @@ namespace {
 // The six edges of a tet as local vertex pairs.
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
-struct PlanarTriangle {
-  Vec3 a, b, c, normal;  // unit normal
-  double double_area = 0;
-  // Is the projection of p onto the plane inside the triangle, with barycentric slack tol?
-  bool contains(const Vec3& p, double tol) const {
-    const Vec3 q = p - normal * normal.dot(p - a);
-    const double u = normal.dot((b - q).cross(c - q)) / double_area;
-    const double v = normal.dot((c - q).cross(a - q)) / double_area;
-    const double w = 1.0 - u - v;
-    return u >= -tol && v >= -tol && w >= -tol;
-  }
-};
-
 struct Split {
   int a, b;  // a < b
   double t;  // crossing at x_a + t (x_b - x_a)
 };
 
 // Volume of the smallest piece tet `nodes` falls into when the crossing edges in `splits`
-// are bisected in that order (the order insert_cut_triangle applies them in). Each piece
+// are bisected in that order (the order split_along_triangle applies them in). Each piece
 // containing an edge being split is bisected, exactly as bisect_edge does.
 double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
   struct Piece {
@@ -67,7 +53,53 @@ double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<S
   return smallest;
 }
 
+std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
+                                  const Vec3& hi) {
+  std::vector<int> tets;
+  if (!(lo.array() <= hi.array()).all()) return tets;
+  for (int t : state.grid.query(mesh, lo, hi))
+    if (state.cuttable[t]) tets.push_back(t);
+  return tets;
+}
+
 }  // namespace
+
+TriangleClassification::TriangleClassification(const Vec3& a, const Vec3& b, const Vec3& c,
+                                               double snap_tolerance)
+    : a_(a), b_(b), c_(c), normal_((b - a).cross(c - a)), snap_tolerance_(snap_tolerance) {
+  double_area_ = normal_.norm();
+  const double diameter = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  degenerate_ = !(double_area_ > 1e-12 * diameter * diameter);  // a plunge sweeps no area
+  if (!degenerate_) normal_ /= double_area_;
+}
+
+bool TriangleClassification::contains(const Vec3& p, double tol) const {
+  const Vec3 q = p - normal_ * normal_.dot(p - a_);
+  const double u = normal_.dot((b_ - q).cross(c_ - q)) / double_area_;
+  const double v = normal_.dot((c_ - q).cross(a_ - q)) / double_area_;
+  return u >= -tol && v >= -tol && 1.0 - u - v >= -tol;
+}
+
+int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int v) {
+  auto it = side_.find(v);
+  if (it != side_.end()) return it->second;
+  const double d = distance(mesh, v);
+  // Snap relative to the LONGEST edge at v, so any edge that still crosses has t in
+  // [snap, 1 - snap] (see CutOptions::snap_tolerance).
+  double longest = 0;
+  for (int t : state.node_tets[v])
+    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
+  const int s = std::abs(d) < snap_tolerance_ * longest ? 0 : (d > 0 ? 1 : -1);
+  side_[v] = s;
+  return s;
+}
+
+void TriangleClassification::bounds(Vec3& lo, Vec3& hi) const {
+  const double diameter = std::max({(b_ - a_).norm(), (c_ - b_).norm(), (a_ - c_).norm()});
+  const Vec3 pad = Vec3::Constant(1e-6 * diameter);
+  lo = a_.cwiseMin(b_).cwiseMin(c_) - pad;
+  hi = a_.cwiseMax(b_).cwiseMax(c_) + pad;
+}
 
 std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet, int face) {
   const Tet& t = mesh.tets[tet];
@@ -87,41 +119,13 @@ std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state,
   return {-1, -1};
 }
 
-void insert_cut_triangle(TetMesh& mesh, CutState& state, const Vec3& a, const Vec3& b,
-                         const Vec3& c, const CutOptions& options, CutResult& result,
-                         std::set<FaceKey>& new_faces) {
-  PlanarTriangle tri{a, b, c, (b - a).cross(c - a), 0};
-  tri.double_area = tri.normal.norm();
-  const double diameter = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-  if (!(tri.double_area > 1e-12 * diameter * diameter)) return;  // a plunge sweeps no area
-  tri.normal /= tri.double_area;
-  const double tol = options.inside_tolerance;
-
-  // Every tet with a crossing edge inside the triangle, or a face on it, overlaps this box.
-  const Vec3 pad = Vec3::Constant(1e-6 * diameter);
-  const Vec3 lo = a.cwiseMin(b).cwiseMin(c) - pad, hi = a.cwiseMax(b).cwiseMax(c) + pad;
-  std::vector<int> candidates;
-  for (int t : state.grid.query(mesh, lo, hi))
-    if (state.cuttable[t]) candidates.push_back(t);
-  if (candidates.empty()) return;
-
-  // (a) Signed distances and sides: -1, +1, or 0 = on the cut (snapped, never moved).
-  std::unordered_map<int, double> distance;
-  std::unordered_map<int, int> side;
-  auto classify = [&](int v) {
-    auto it = side.find(v);
-    if (it != side.end()) return it->second;
-    const double d = tri.normal.dot(mesh.nodes[v] - a);
-    double longest = 0;
-    for (int t : state.node_tets[v])
-      for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
-    const int s = std::abs(d) < options.snap_tolerance * longest ? 0 : (d > 0 ? 1 : -1);
-    distance[v] = d;
-    side[v] = s;
-    return s;
-  };
-  for (int t : candidates)
-    for (int v : mesh.tets[t]) classify(v);
+void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification& tri,
+                          const CutOptions& options, CutResult& result) {
+  if (tri.degenerate()) return;
+  // Every tet with a crossing edge inside the triangle overlaps its box.
+  Vec3 lo, hi;
+  tri.bounds(lo, hi);
+  const std::vector<int> candidates = cuttable_tets_in(mesh, state, lo, hi);
 
   // (b) Crossing edges inside the triangle. The volume guard may snap an end to "on", which
   // only removes crossing edges, so the loop ends.
@@ -132,13 +136,14 @@ void insert_cut_triangle(TetMesh& mesh, CutState& state, const Vec3& a, const Ve
       const Tet& tet = mesh.tets[t];
       for (const auto& e : kTetEdges) {
         int u = tet[e[0]], v = tet[e[1]];
-        if (side[u] * side[v] != -1) continue;
+        if (tri.side(mesh, state, u) * tri.side(mesh, state, v) != -1) continue;
         if (u > v) std::swap(u, v);
         if (crossing.count({u, v})) continue;
         if (state.locked[u] && state.locked[v]) continue;  // interface edges stay whole
-        const double du = distance[u], dv = distance[v];
+        const double du = tri.distance(mesh, u), dv = tri.distance(mesh, v);
         const double s = du / (du - dv);
-        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), tol)) continue;
+        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), options.inside_tolerance))
+          continue;
         crossing[{u, v}] = s;
       }
     }
@@ -152,31 +157,30 @@ void insert_cut_triangle(TetMesh& mesh, CutState& state, const Vec3& a, const Ve
         if (it != crossing.end()) splits.push_back({u, v, it->second});
       }
       if (splits.empty()) continue;
-      std::sort(splits.begin(), splits.end(),
-                [](const Split& x, const Split& y) { return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b); });
+      std::sort(splits.begin(), splits.end(), [](const Split& x, const Split& y) {
+        return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
+      });
       if (smallest_piece(mesh, tet, splits) >= options.min_volume_fraction * state.origin_volume[t])
         continue;
-      // Snap the end nearest the plane among this tet's crossing edges.
+      // Too small a piece: snap the end nearest the plane among this tet's crossing edges.
       int nearest = -1;
       double best = 2.0;
       for (const Split& s : splits) {
         if (s.t < best) best = s.t, nearest = s.a;
         if (1 - s.t < best) best = 1 - s.t, nearest = s.b;
       }
-      side[nearest] = 0;
+      tri.set_on(nearest);
       snapped = true;
     }
     if (!snapped) break;
   }
 
-  const int tets_before_splits = mesh.num_tets();
   // Bisect in (a, b) order, so each tet is cut into exactly the pieces the guard checked.
   for (const auto& [edge, t] : crossing) {
     const size_t before = result.changed_tets.size();
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
-    side[m] = 0;
-    distance[m] = 0;
+    tri.set_on(m);
     NewNode node;
     node.index = m;
     node.kind = NewNode::Kind::kEdgeSplit;
@@ -185,23 +189,29 @@ void insert_cut_triangle(TetMesh& mesh, CutState& state, const Vec3& a, const Ve
     node.t = t;
     result.new_nodes.push_back(node);
   }
-  // The appended children are candidates too.
-  for (int t = tets_before_splits; t < mesh.num_tets(); ++t) candidates.push_back(t);
+}
 
+void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri,
+                            const Vec3& lo, const Vec3& hi, const CutOptions& options,
+                            CutResult& result, std::set<FaceKey>& new_faces) {
+  if (tri.degenerate()) return;
   // (c) Faces on the cut: three "on" nodes, centroid inside the triangle, tets on opposite
   // sides. Both tets get the face's bit.
-  for (int t : candidates) {
+  for (int t : cuttable_tets_in(mesh, state, lo, hi)) {
     for (int f = 0; f < 4; ++f) {
       if (mesh.is_cut_face(t, f)) continue;
       const Tet& tet = mesh.tets[t];
       const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
-      if (classify(p) != 0 || classify(q) != 0 || classify(r) != 0) continue;
-      const int here = classify(tet[f]);
+      if (tri.side(mesh, state, p) != 0 || tri.side(mesh, state, q) != 0 ||
+          tri.side(mesh, state, r) != 0)
+        continue;
+      const int here = tri.side(mesh, state, tet[f]);
       if (here == 0) continue;
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
-      if (classify(mesh.tets[other][other_face]) != -here) continue;
-      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0, tol)) continue;
+      if (tri.side(mesh, state, mesh.tets[other][other_face]) != -here) continue;
+      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0, options.inside_tolerance))
+        continue;
       if (!state.cuttable[other]) {  // the blade stops at the condensed part
         result.reached_interface = true;
         continue;

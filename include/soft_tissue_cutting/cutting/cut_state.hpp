@@ -5,6 +5,8 @@
 #include "soft_tissue_cutting/cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +25,12 @@ struct CutState {
   std::vector<std::vector<int>> node_tets;
   // Cuttable tets by rest-position box.
   TetGrid grid;
+  // The last sweep's triangles and end edge (tip, heel). A sweep that starts where the last
+  // one ended also marks faces whose centroid lies in the last sweep's triangles: faces that
+  // only appear when this sweep splits the tets straddling the shared edge line, and that
+  // neither sweep's own triangles would claim.
+  std::vector<std::array<Vec3, 3>> last_sweep;
+  std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
 };
 
 // locked: per node (empty = none); cuttable: per tet (empty = all). Also sizes

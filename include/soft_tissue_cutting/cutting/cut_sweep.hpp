@@ -19,8 +19,10 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
                     const CutOptions& options = {});
 
 // Any list of planar triangles, inserted as one cut (one separation at the end).
+// also_mark_in: see insert_cut_triangle.
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
-                        const CutOptions& options = {});
+                        const CutOptions& options = {},
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {});
 
 }  // namespace stc
