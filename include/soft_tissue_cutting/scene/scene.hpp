@@ -99,6 +99,10 @@ struct Scene {
   ScalpelParams scalpel;
   std::vector<BladePose> trajectory;
   SolverParams solver;
+  // `mesh.tetgen.switches` used for a surface mesh file (empty: MeshReadOptions' default).
+  std::string tetgen_switches;
+  // Non-fatal findings while loading (e.g. the mesh's tets were flipped), one line each.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace stc
