@@ -1,0 +1,31 @@
+// Message conversion between the ROS-free core and ROS messages (no physics here).
+#pragma once
+
+#include "soft_tissue_cutting/simulation/simulation.hpp"
+
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <soft_tissue_cutting/SimStats.h>
+
+#include <string>
+
+namespace stc {
+namespace ros_io {
+
+// geometry_msgs/Pose <-> BladePose (scene frame). The orientation is normalised on the way in.
+BladePose to_blade_pose(const geometry_msgs::Pose& pose, double t);
+geometry_msgs::Pose to_pose_msg(const BladePose& pose);
+
+// True when every component is finite and the quaternion is not (near) zero.
+bool is_finite_pose(const geometry_msgs::Pose& pose);
+
+// One step's SimStats: StepStats + sizes of the current state + backend in use.
+soft_tissue_cutting::SimStats to_stats_msg(const StepStats& step, const ModelCounts& counts,
+                                           const std::string& backend,
+                                           const std::string& renderer, double rate_hz);
+
+// Reaction force of the tissue on the blade, in the scene frame; torque is not modelled (0).
+geometry_msgs::WrenchStamped to_wrench_msg(const StepStats& step);
+
+}  // namespace ros_io
+}  // namespace stc
