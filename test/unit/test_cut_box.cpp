@@ -81,3 +81,37 @@ TEST(CutBox, CutAlongNodePlaneSplitsNothing) {
 
 }  // namespace
 }  // namespace stc
+
+namespace stc {
+namespace {
+
+TEST(CutInvariants, CheckerReportsEachKindOfViolation) {
+  GeneratorParams g;
+  g.size = Vec3(0.02, 0.02, 0.02);
+  g.cells = {2, 2, 2};
+  TetMesh mesh = make_box_mesh(g);
+  CutState state = make_cut_state(mesh, {}, {});
+  InvariantLimits limits;
+  limits.initial_volume = total_volume(mesh);
+  EXPECT_TRUE(check_cut_invariants(mesh, state.origin_volume, limits).empty());
+
+  TetMesh extra_node = mesh;
+  extra_node.nodes.push_back(Vec3::Zero());
+  EXPECT_EQ(check_cut_invariants(extra_node, state.origin_volume, limits).size(), 1u);
+
+  TetMesh duplicate = mesh;
+  duplicate.tets.push_back(mesh.tets[0]);
+  duplicate.cut_faces.push_back(0);
+  std::vector<double> sizes = state.origin_volume;
+  sizes.push_back(sizes[0]);
+  // duplicate tet, volume grows, non-manifold faces
+  EXPECT_EQ(check_cut_invariants(duplicate, sizes, limits).size(), 3u);
+
+  TetMesh sliver = mesh;  // a node pushed almost into its opposite face
+  limits.min_volume_fraction = 0.999;
+  sliver.nodes[sliver.tets[0][0]] += Vec3(1e-4, 1e-4, 1e-4);
+  EXPECT_GE(check_cut_invariants(sliver, state.origin_volume, limits).size(), 1u);
+}
+
+}  // namespace
+}  // namespace stc
