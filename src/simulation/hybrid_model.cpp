@@ -151,20 +151,23 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   if (n - old_nodes != static_cast<int>(new_nodes.size()))
     throw std::invalid_argument("HybridModel::update_operation_part: new_nodes does not match "
                                 "the nodes appended to the mesh");
-  // New nodes: displacement interpolated from their parents, unloaded, free.
+  // New nodes: displacement interpolated from their parents (cut_result.hpp), unloaded.
   u_.conservativeResize(3 * n);
   point_loads_.conservativeResize(3 * n);
   fixed_.resize(static_cast<size_t>(n), 0);
   for (int k = 0; k < static_cast<int>(new_nodes.size()); ++k) {
     const int node = old_nodes + k;
     const NewNode& nn = new_nodes[static_cast<size_t>(k)];
-    Vec3 u = Vec3::Zero();
-    for (size_t p = 0; p < nn.parents.size(); ++p) {
-      if (nn.parents[p] < 0 || nn.parents[p] >= node)
-        throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
-      u += nn.weights[p] * u_.segment<3>(3 * nn.parents[p]);
+    const bool split = nn.kind == NewNode::Kind::kEdgeSplit;
+    if (nn.a < 0 || nn.a >= node || (split && (nn.b < 0 || nn.b >= node)))
+      throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
+    if (split) {
+      u_.segment<3>(3 * node) = (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
+      fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
+    } else {
+      u_.segment<3>(3 * node) = u_.segment<3>(3 * nn.a);
+      fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)];
     }
-    u_.segment<3>(3 * node) = u;
     point_loads_.segment<3>(3 * node).setZero();
   }
   // Only the changed element matrices are recomputed.

@@ -177,7 +177,13 @@ void split_edge(HybridModel& h, int a, int b) {
     changed.push_back(m.num_tets() - 1);
   }
   ASSERT_FALSE(changed.empty());
-  h.update_operation_part(changed, {NewNode{{a, b}, {0.5, 0.5}}});
+  NewNode node;
+  node.index = mid;
+  node.kind = NewNode::Kind::kEdgeSplit;
+  node.a = a;
+  node.b = b;
+  node.t = 0.5;
+  h.update_operation_part(changed, {node});
 }
 
 // An edge of a part-1 tet between nodes of the given sets.

@@ -9,6 +9,7 @@
 
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/condensation/condensed_part.hpp"
+#include "soft_tissue_cutting/cutting/cut_result.hpp"  // NewNode: how the cutting stage adds nodes
 #include "soft_tissue_cutting/partition/partition.hpp"
 #include "soft_tissue_cutting/recovery/surface_recovery.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
@@ -24,14 +25,6 @@ namespace stc {
 
 // Imposed displacements: node -> displacement (scalpel contact, held free pieces).
 using ImposedDisplacements = std::map<int, Vec3>;
-
-// A node appended by the cutting stage; its displacement starts as sum_k w_k u(parent_k)
-// (e.g. the midpoint of a split edge: parents {a, b}, weights {0.5, 0.5}; a duplicated node
-// along a cut: one parent, weight 1).
-struct NewNode {
-  std::vector<int> parents;
-  std::vector<double> weights;
-};
 
 // Sizes for the stats (SPEC section 4); fixed nodes count in their set.
 struct HybridModelCounts {
@@ -71,7 +64,8 @@ class HybridModel {
   // Cutting hook: the operation part of mesh_for_cutting() was changed in place (tets
   // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
   // (all become operation tets); new_nodes: one entry per appended node, in order (all become
-  // O nodes, free, unloaded). Only the changed element matrices are recomputed; K0, g0, R,
+  // O nodes, unloaded; an edge node starts at (1 - t) u_a + t u_b and is fixed only if both
+  // ends are; a duplicate starts at u_a and keeps a's fixed flag). Only the changed element matrices are recomputed; K0, g0, R,
   // c_S are untouched. Consistent gravity of the changed tets is re-lumped.
   void update_operation_part(const std::vector<int>& changed_tets,
                              const std::vector<NewNode>& new_nodes);
