@@ -1,29 +1,218 @@
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
+#include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/cutting/cut_state.hpp"
+#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
+#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "soft_tissue_cutting/gpu/gl_solver.hpp"
+#include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
+
 #include <chrono>
 #include <cstdio>
-#include <functional>
-#include <sstream>
 #include <stdexcept>
 
 namespace stc {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The blade tip lies inside the (rest) tissue: in some tet near it.
+bool tip_inside_tissue(const TetMesh& mesh, const CutState& state, const Vec3& tip) {
+  for (int t : state.grid.query(mesh, tip, tip)) {
+    const Tet& k = mesh.tets[t];
+    const Vec3 &a = mesh.nodes[k[0]], &b = mesh.nodes[k[1]], &c = mesh.nodes[k[2]],
+               &d = mesh.nodes[k[3]];
+    const double v = signed_volume(a, b, c, d);
+    const double eps = -1e-12 * std::abs(v);
+    if (signed_volume(tip, b, c, d) >= eps && signed_volume(a, tip, c, d) >= eps &&
+        signed_volume(a, b, tip, d) >= eps && signed_volume(a, b, c, tip) >= eps)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 struct Simulation::Impl {
-  Scene initial;
+  Scene initial;   // as loaded: reset() returns here
+  Scene scene;     // live parameters (cut pressure, E)
   SimulationOptions options;
-  TetMesh mesh;
-  Eigen::VectorXd u;
-  StepStats last;
-  std::uint64_t steps = 0;
-  std::uint64_t surface_version = 0;
+  std::string backend_note, renderer, backend = "cpu";
+  std::unique_ptr<HybridModel> model;
+  CutState cut_state;
+  BoundarySurface boundary;  // of the whole current mesh, rebuilt after cuts
+  std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
+  ImposedDisplacements held;           // free pieces, held where they came free
+  int free_pieces_held = 0;
+
+  enum class BladeState { kFree, kPressing, kCutting } blade_state = BladeState::kFree;
+  std::optional<ContactAnchor> anchor;
+  std::optional<BladePose> last_pose;
+  std::vector<BladePose> stroke;  // poses of the current cutting stroke
+
   bool cutting_enabled = true;
+  std::uint64_t steps = 0, surface_version = 0;
+  int cuts = 0, tets_split = 0;
+  StepStats last;
+
+  std::unique_ptr<LinearSolver> make_solver() {
+    const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
+    backend = "cpu";
+    renderer.clear();
+    if (wanted == "gl") {
+      std::string why;
+      if (auto gl = make_gl_solver(&why)) {
+        backend = "gl";
+        renderer = gl->renderer();
+        return gl;
+      }
+      backend_note = "gl backend unavailable (" + why + "); solving on the cpu";
+    } else if (wanted != "cpu") {
+      throw std::invalid_argument("solver.backend: '" + wanted + "' is not cpu or gl");
+    }
+    return make_cpu_solver();
+  }
 
   void start() {
-    mesh = initial.mesh;
-    u = Eigen::VectorXd::Zero(3 * mesh.num_nodes());
-    last = StepStats{};
+    scene = initial;
+    model = std::make_unique<HybridModel>(scene, make_solver());
+    model->set_cg_settings(CgSettings{scene.solver.tolerance, scene.solver.max_iterations});
+    // Only the operation part is cut; interface nodes stay whole so K0/R stay valid.
+    const Partition& p = model->partition();
+    std::vector<std::uint8_t> locked(static_cast<size_t>(model->mesh().num_nodes()), 0);
+    for (int i : p.interface) locked[static_cast<size_t>(i)] = 1;
+    cut_state = make_cut_state(model->mesh_for_cutting(), locked, p.operation_tet);
+    anchored = model->fixed_nodes();
+    for (int i : p.interface) anchored[static_cast<size_t>(i)] = 1;
+    held.clear();
+    free_pieces_held = 0;
+    blade_state = BladeState::kFree;
+    anchor.reset();
+    last_pose.reset();
+    stroke.clear();
     steps = 0;
+    cuts = tets_split = 0;
+    last = StepStats{};
+    boundary = extract_boundary_surface(model->mesh());
+    // The initial equilibrium under the scene's loads.
+    last.converged = solve({}, last);
     ++surface_version;
+  }
+
+  bool solve(const ImposedDisplacements& contact, StepStats& s) {
+    ImposedDisplacements imposed = held;
+    imposed.insert(contact.begin(), contact.end());  // held pieces win over contact
+    const auto t0 = Clock::now();
+    const CgResult r = model->solve(imposed);
+    s.solve_ms += ms_since(t0);
+    s.cg_iterations += r.iterations;
+    s.residual = r.residual;
+    return r.converged;
+  }
+
+  // Inserts the sweep between two blade poses; returns true if the mesh changed.
+  bool cut(const BladePose& from, const BladePose& to, StepStats& s) {
+    const double length = scene.scalpel.blade_length;
+    auto t0 = Clock::now();
+    const CutResult r = cut_sweep(model->mesh_for_cutting(), cut_state, blade_edge(from, length),
+                                  blade_edge(to, length));
+    s.cutting_ms += ms_since(t0);
+    s.reached_interface |= r.reached_interface;
+    if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
+    t0 = Clock::now();
+    model->update_operation_part(r.changed_tets, r.new_nodes);
+    anchored.resize(static_cast<size_t>(model->mesh().num_nodes()), 0);
+    for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
+      if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
+    hold_free_pieces();
+    boundary = extract_boundary_surface(model->mesh());
+    s.assembly_ms += ms_since(t0);
+    s.tets_split += r.tets_split;
+    s.nodes_added += r.nodes_added;
+    s.cutting = true;
+    tets_split += r.tets_split;
+    ++cuts;
+    return true;
+  }
+
+  // SPEC 6: a piece severed from everything anchored is kept and held where it is.
+  void hold_free_pieces() {
+    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+      for (int n : piece.nodes) {
+        held[n] = model->displacement().segment<3>(3 * n);
+        anchored[static_cast<size_t>(n)] = 1;
+      }
+      ++free_pieces_held;
+      std::fprintf(stderr,
+                   "soft_tissue_cutting: a piece of %zu tets was cut free; it is held in place\n",
+                   piece.tets.size());
+    }
+  }
+
+  std::vector<BoundaryTriangle> operation_surface() const {
+    std::vector<BoundaryTriangle> out;
+    const auto& op = model->partition().operation_tet;
+    for (const BoundaryTriangle& t : boundary.triangles)
+      if (op[static_cast<size_t>(t.tet)]) out.push_back(t);
+    return out;
+  }
+
+  StepStats step(const std::optional<BladePose>& blade) {
+    const auto t_step = Clock::now();
+    StepStats s;
+    s.step = ++steps;
+    ImposedDisplacements contact;
+    if (!blade) {
+      blade_state = BladeState::kFree;
+      anchor.reset();
+    } else {
+      const Vec3 tip = blade->position;
+      auto t0 = Clock::now();
+      if (blade_state == BladeState::kCutting) {
+        // The blade opens the tissue while its tip is in it; out of the tissue, it is free.
+        if (last_pose) cut(*last_pose, *blade, s);
+        stroke.push_back(*blade);
+        if (!tip_inside_tissue(model->mesh(), cut_state, tip)) {
+          blade_state = BladeState::kFree;
+          stroke.clear();
+        }
+      } else {
+        if (blade_state == BladeState::kFree) {
+          anchor = find_contact(model->mesh(), model->displacement(), operation_surface(), tip,
+                                0.5 * scene.scalpel.blade_length);
+          if (anchor) blade_state = BladeState::kPressing;
+        }
+        if (blade_state == BladeState::kPressing) {
+          if (const auto d = anchored_displacement(*anchor, tip)) {
+            for (int n : anchor->nodes) contact[n] = *d;
+          } else {
+            blade_state = BladeState::kFree;
+            anchor.reset();
+          }
+        }
+      }
+      s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
+    }
+    s.converged = solve(contact, s);
+    if (!contact.empty()) {
+      s.in_contact = true;
+      // The tissue pushes back on the blade with minus the force that holds its nodes.
+      s.contact_force = -model->reaction_force({anchor->nodes.begin(), anchor->nodes.end()});
+      if (cutting_enabled && s.contact_force.norm() > scene.scalpel.cut_pressure) {
+        blade_state = BladeState::kCutting;  // the tissue yields: the next motion cuts
+        anchor.reset();
+        stroke = {*blade};
+      }
+    }
+    last_pose = blade;
+    ++surface_version;
+    s.step_ms = ms_since(t_step);
+    last = s;
+    return s;
   }
 };
 
@@ -35,72 +224,98 @@ Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl)
 
 Simulation::~Simulation() = default;
 
-StepStats Simulation::step(const std::optional<BladePose>&) {
-  StepStats s;
-  s.step = ++impl_->steps;
-  impl_->last = s;
-  return s;
-}
+StepStats Simulation::step(const std::optional<BladePose>& blade) { return impl_->step(blade); }
 
-CutOutcome Simulation::cut_along(const std::vector<BladePose>&) {
-  return CutOutcome{false, "cutting not available yet", 0, 0, 0};
+CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
+  CutOutcome out;
+  if (poses.size() < 2) {
+    out.message = "need at least two blade poses to sweep a cut";
+    return out;
+  }
+  const int faces_before = [&] {
+    int n = 0;
+    for (const auto& t : impl_->boundary.triangles) n += t.cut;
+    return n;
+  }();
+  StepStats s;
+  for (size_t i = 1; i < poses.size(); ++i) impl_->cut(poses[i - 1], poses[i], s);
+  s.converged = impl_->solve({}, s);
+  ++impl_->surface_version;
+  int faces_after = 0;
+  for (const auto& t : impl_->boundary.triangles) faces_after += t.cut;
+  out.tets_split = s.tets_split;
+  out.nodes_added = s.nodes_added;
+  out.cut_faces = faces_after - faces_before;
+  out.success = s.cutting;
+  out.message = s.cutting ? "cut inserted" : "the blade path does not cross the operation part";
+  if (s.reached_interface) out.message += "; stopped at the interface of the condensed part";
+  if (!s.converged) out.message += "; warning: the solver did not converge";
+  return out;
 }
 
 void Simulation::reset() { impl_->start(); }
 void Simulation::set_cutting_enabled(bool enabled) { impl_->cutting_enabled = enabled; }
 bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
-void Simulation::set_cut_pressure(double newtons) { impl_->initial.scalpel.cut_pressure = newtons; }
-void Simulation::set_young_modulus(double pascal) { impl_->initial.material.young_modulus = pascal; }
-const Scene& Simulation::scene() const { return impl_->initial; }
-const TetMesh& Simulation::mesh() const { return impl_->mesh; }
+void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
+void Simulation::set_young_modulus(double pascal) {
+  if (!(pascal > 0)) throw std::invalid_argument("young_modulus must be > 0");
+  impl_->scene.material.young_modulus = pascal;
+  impl_->model->set_young_modulus(pascal);
+}
+const Scene& Simulation::scene() const { return impl_->scene; }
+const TetMesh& Simulation::mesh() const { return impl_->model->mesh(); }
 
 DeformedSurface Simulation::surface() const {
   DeformedSurface s;
-  const TetMesh& m = impl_->mesh;
+  const TetMesh& m = impl_->model->mesh();
+  const Vector& u = impl_->model->displacement();
   s.positions.resize(m.nodes.size());
   s.displacement.resize(m.nodes.size());
   for (int i = 0; i < m.num_nodes(); ++i) {
-    const Vec3 u = impl_->u.segment<3>(3 * i);
-    s.positions[i] = m.nodes[i] + u;
-    s.displacement[i] = u.norm();
+    const Vec3 ui = u.segment<3>(3 * i);
+    s.positions[i] = m.nodes[i] + ui;
+    s.displacement[i] = ui.norm();
   }
-  s.triangles = extract_boundary_surface(m).triangles;
+  s.triangles = impl_->boundary.triangles;
   return s;
 }
 
 std::uint64_t Simulation::surface_version() const { return impl_->surface_version; }
 
 ModelCounts Simulation::counts() const {
+  const HybridModelCounts h = impl_->model->counts();
   ModelCounts c;
-  c.nodes = impl_->mesh.num_nodes();
-  c.tets = impl_->mesh.num_tets();
+  c.nodes = h.nodes;
+  c.tets = h.tets;
+  c.dof_operation = h.dof_operation;
+  c.nodes_interface = h.nodes_interface;
+  c.nodes_surface_condensed = h.nodes_surface_condensed;
+  c.nodes_interior_condensed = h.nodes_interior_condensed;
+  c.cuts = impl_->cuts;
+  c.tets_split = impl_->tets_split;
+  c.free_pieces_held = impl_->free_pieces_held;
   c.volume_initial = total_volume(impl_->initial.mesh);
-  c.volume_final = total_volume(impl_->mesh);
+  c.volume_final = total_volume(impl_->model->mesh());
   return c;
 }
 
 const StepStats& Simulation::last_stats() const { return impl_->last; }
-std::string Simulation::backend() const { return "cpu"; }
-std::string Simulation::renderer() const { return ""; }
-std::string Simulation::backend_note() const { return ""; }
-
+std::string Simulation::backend() const { return impl_->backend; }
+std::string Simulation::renderer() const { return impl_->renderer; }
+std::string Simulation::backend_note() const { return impl_->backend_note; }
 std::vector<std::uint8_t> Simulation::tet_regions() const {
-  std::vector<std::uint8_t> r(impl_->mesh.tets.size());
-  for (size_t t = 0; t < r.size(); ++t) {
-    Vec3 c = Vec3::Zero();
-    for (int v : impl_->mesh.tets[t]) c += impl_->mesh.nodes[v] / 4.0;
-    r[t] = impl_->initial.operation_region.contains(c);
-  }
-  return r;
+  return impl_->model->partition().operation_tet;
+}
+std::vector<BladePose> Simulation::blade_path() const { return impl_->stroke; }
+
+Eigen::VectorXd Simulation::full_displacement() {
+  impl_->model->recover_interior();
+  return impl_->model->displacement();
 }
 
-std::vector<BladePose> Simulation::blade_path() const { return {}; }
-Eigen::VectorXd Simulation::full_displacement() { return impl_->u; }
-void Simulation::write_vtk(const std::string&) { throw std::runtime_error("write_vtk: not yet"); }
-void Simulation::write_stats_json(const std::string&, double) {
-  throw std::runtime_error("write_stats_json: not yet");
+const std::map<std::string, double>& Simulation::precompute_timings_ms() const {
+  return impl_->model->precompute_timings_ms();
 }
-std::string Simulation::stats_json(double) { return "{}"; }
 
 std::string Simulation::mesh_hash() const {
   // FNV-1a over the topology and the rest positions' bits: equal meshes, equal hashes.
@@ -109,8 +324,9 @@ std::string Simulation::mesh_hash() const {
     const auto* p = static_cast<const unsigned char*>(data);
     for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
   };
-  for (const Vec3& x : impl_->mesh.nodes) mix(x.data(), 3 * sizeof(double));
-  for (const Tet& t : impl_->mesh.tets) mix(t.data(), 4 * sizeof(int));
+  const TetMesh& m = impl_->model->mesh();
+  for (const Vec3& x : m.nodes) mix(x.data(), 3 * sizeof(double));
+  for (const Tet& t : m.tets) mix(t.data(), 4 * sizeof(int));
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;

@@ -7,6 +7,7 @@
 #include "soft_tissue_cutting/scene/scene.hpp"
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -94,6 +95,8 @@ class Simulation {
   void write_vtk(const std::string& path);
   void write_stats_json(const std::string& path, double total_ms);
   std::string stats_json(double total_ms);
+  // Precompute stage timings of the condensation (ms), as the hybrid model measured them.
+  const std::map<std::string, double>& precompute_timings_ms() const;
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;
 

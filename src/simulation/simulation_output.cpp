@@ -1,0 +1,58 @@
+// The offline outputs of SPEC section 4: the VTK state and the JSON statistics.
+#include "soft_tissue_cutting/io/vtk_writer.hpp"
+#include "soft_tissue_cutting/simulation/simulation.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <stdexcept>
+
+namespace stc {
+
+void Simulation::write_vtk(const std::string& path) {
+  const Eigen::VectorXd u = full_displacement();  // interior condensed nodes recovered
+  stc::write_vtk(path, mesh(), u, tet_regions());
+}
+
+std::string Simulation::stats_json(double total_ms) {
+  const ModelCounts c = counts();
+  const StepStats& s = last_stats();
+  nlohmann::ordered_json j;
+  j["nodes"] = c.nodes;
+  j["tets"] = c.tets;
+  j["dof_operation"] = c.dof_operation;
+  j["nodes_interface"] = c.nodes_interface;
+  j["nodes_surface_condensed"] = c.nodes_surface_condensed;
+  j["nodes_interior_condensed"] = c.nodes_interior_condensed;
+  j["cuts"] = c.cuts;
+  j["tets_split"] = c.tets_split;
+  j["free_pieces_held"] = c.free_pieces_held;
+  j["volume_initial"] = c.volume_initial;
+  j["volume_final"] = c.volume_final;
+  j["cg_iterations"] = s.cg_iterations;
+  j["residual"] = s.residual;
+  j["converged"] = s.converged;
+  j["backend"] = backend();
+  if (backend() == "gl") j["renderer"] = renderer();
+  if (!backend_note().empty()) j["backend_note"] = backend_note();
+  j["steps"] = s.step;
+  nlohmann::ordered_json t;
+  for (const auto& [stage, ms] : precompute_timings_ms()) t["precompute_" + stage] = ms;
+  t["last_step_collision"] = s.collision_ms;
+  t["last_step_cutting"] = s.cutting_ms;
+  t["last_step_assembly"] = s.assembly_ms;
+  t["last_step_solve"] = s.solve_ms;
+  t["last_step"] = s.step_ms;
+  t["total"] = total_ms;
+  j["timings_ms"] = t;
+  return j.dump(2);
+}
+
+void Simulation::write_stats_json(const std::string& path, double total_ms) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  out << stats_json(total_ms) << "\n";
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace stc
