@@ -1,0 +1,71 @@
+// Small helpers shared by the rostests (header-only: each rostest is one .cpp file).
+#pragma once
+
+#include <ros/ros.h>
+#include <visualization_msgs/Marker.h>
+
+#include <array>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <utility>
+
+namespace tissue_test {
+
+// Spins (the global queue) until pred() holds or timeout seconds pass.
+inline bool spin_until(const std::function<bool()>& pred, double timeout) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (pred()) return true;
+    ros::WallDuration(0.005).sleep();
+  }
+  ros::spinOnce();
+  return pred();
+}
+
+inline void spin_for(double seconds) {
+  spin_until([] { return false; }, seconds);
+}
+
+struct TriangleSoup {
+  int triangles = 0;
+  int vertices = 0;         // distinct positions
+  int bad_edges = 0;        // undirected edges not used exactly twice in opposite directions
+};
+
+// Welds a TRIANGLE_LIST's points by exact coordinates and checks that it is closed and
+// consistently oriented: every edge used twice, once in each direction.
+inline TriangleSoup analyse(const visualization_msgs::Marker& m) {
+  TriangleSoup out;
+  std::map<std::array<double, 3>, int> ids;
+  auto id = [&ids](const geometry_msgs::Point& p) {
+    return ids.emplace(std::array<double, 3>{p.x, p.y, p.z}, static_cast<int>(ids.size()))
+        .first->second;
+  };
+  std::map<std::pair<int, int>, int> directed;
+  out.triangles = static_cast<int>(m.points.size() / 3);
+  for (size_t i = 0; i + 2 < m.points.size(); i += 3) {
+    const int v[3] = {id(m.points[i]), id(m.points[i + 1]), id(m.points[i + 2])};
+    for (int k = 0; k < 3; ++k) ++directed[{v[k], v[(k + 1) % 3]}];
+  }
+  out.vertices = static_cast<int>(ids.size());
+  for (const auto& [e, n] : directed) {
+    auto back = directed.find({e.second, e.first});
+    if (n != 1 || back == directed.end() || back->second != 1) ++out.bad_edges;
+  }
+  return out;
+}
+
+// Bit-for-bit equality of two point lists.
+inline bool same_points(const visualization_msgs::Marker& a, const visualization_msgs::Marker& b) {
+  if (a.points.size() != b.points.size()) return false;
+  for (size_t i = 0; i < a.points.size(); ++i) {
+    const double pa[3] = {a.points[i].x, a.points[i].y, a.points[i].z};
+    const double pb[3] = {b.points[i].x, b.points[i].y, b.points[i].z};
+    if (std::memcmp(pa, pb, sizeof pa) != 0) return false;
+  }
+  return true;
+}
+
+}  // namespace tissue_test
