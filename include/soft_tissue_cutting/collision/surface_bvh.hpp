@@ -1,0 +1,46 @@
+// The tissue's current boundary surface at its DEFORMED positions (rest + displacement), in
+// an AABB tree: what the blade is tested against every step. Triangles owned by operation-part
+// tets are the ones the blade can touch (contact.hpp); the whole closed surface answers
+// point-in-tissue queries by ray parity.
+#pragma once
+
+#include "soft_tissue_cutting/collision/aabb_tree.hpp"
+#include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace stc {
+
+class SurfaceBvh {
+ public:
+  // After every cut (the surface changed). operation_tets: per tet, nonzero = operation part
+  // (empty = all). displacement: per node (empty = rest shape).
+  void build(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
+             const std::vector<Vec3>& displacement);
+  // Every step (same surface, nodes moved).
+  void refit(const TetMesh& mesh, const std::vector<Vec3>& displacement);
+
+  const BoundarySurface& surface() const { return surface_; }
+  bool is_operation(int triangle) const { return operation_[triangle] != 0; }
+  const Vec3& position(int node) const { return positions_[node]; }  // deformed
+
+  // Triangles whose box comes within `margin` of segment [a, b]'s box (candidates).
+  std::vector<int> near_segment(const Vec3& a, const Vec3& b, double margin) const;
+  // Is p inside the tissue? Ray parity over the whole closed surface.
+  bool contains(const Vec3& p) const;
+
+ private:
+  void update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement);
+  std::vector<Box3> triangle_boxes() const;
+  BoundarySurface surface_;
+  std::vector<std::uint8_t> operation_;
+  std::vector<Vec3> positions_;
+  AabbTree tree_;
+};
+
+// Does segment [p, q] cross triangle (a, b, c)? On a hit, s = the segment parameter.
+bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
+                              const Vec3& c, double& s);
+
+}  // namespace stc

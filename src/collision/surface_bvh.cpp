@@ -1,0 +1,89 @@
+#include "soft_tissue_cutting/collision/surface_bvh.hpp"
+
+#include <cmath>
+
+namespace stc {
+
+bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
+                              const Vec3& c, double& s) {
+  // Moeller-Trumbore on the segment's direction; barycentrics half-open so a ray through a
+  // shared edge is counted by one of its two triangles only (exact ties are measure zero).
+  const Vec3 dir = q - p, e1 = b - a, e2 = c - a;
+  const Vec3 h = dir.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return false;
+  const double inv = 1.0 / det;
+  const Vec3 w = p - a;
+  const double u = w.dot(h) * inv;
+  if (u < 0 || u >= 1) return false;
+  const Vec3 k = w.cross(e1);
+  const double v = dir.dot(k) * inv;
+  if (v < 0 || u + v >= 1) return false;
+  s = e2.dot(k) * inv;
+  return s >= 0 && s <= 1;
+}
+
+void SurfaceBvh::update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
+  positions_ = mesh.nodes;
+  if (displacement.size() == mesh.nodes.size())
+    for (size_t i = 0; i < positions_.size(); ++i) positions_[i] += displacement[i];
+}
+
+std::vector<Box3> SurfaceBvh::triangle_boxes() const {
+  std::vector<Box3> boxes;
+  boxes.reserve(surface_.triangles.size());
+  for (const auto& tri : surface_.triangles) {
+    Box3 box(positions_[tri.nodes[0]]);
+    box.extend(positions_[tri.nodes[1]]);
+    box.extend(positions_[tri.nodes[2]]);
+    boxes.push_back(box);
+  }
+  return boxes;
+}
+
+void SurfaceBvh::build(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
+                       const std::vector<Vec3>& displacement) {
+  surface_ = extract_boundary_surface(mesh);
+  operation_.resize(surface_.triangles.size());
+  for (size_t i = 0; i < surface_.triangles.size(); ++i)
+    operation_[i] = operation_tets.empty() || operation_tets[surface_.triangles[i].tet];
+  update_positions(mesh, displacement);
+  tree_.build(triangle_boxes());
+}
+
+void SurfaceBvh::refit(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
+  update_positions(mesh, displacement);
+  tree_.refit(triangle_boxes());
+}
+
+std::vector<int> SurfaceBvh::near_segment(const Vec3& a, const Vec3& b, double margin) const {
+  Box3 box(a);
+  box.extend(b);
+  box.min().array() -= margin;
+  box.max().array() += margin;
+  std::vector<int> found;
+  tree_.overlapping(box, found);
+  return found;
+}
+
+bool SurfaceBvh::contains(const Vec3& p) const {
+  // A direction no structured mesh lines up with, so ties with edges are vanishingly rare.
+  const Vec3 dir = Vec3(0.5773502691896258, 0.5773502691896257, 0.5773502691896259).normalized() +
+                   Vec3(1.3e-3, -2.9e-3, 0.7e-3);
+  std::vector<int> candidates;
+  tree_.along_ray(p, dir, candidates);
+  // Segment long enough to leave every box: the ray is clipped by the scene's extent.
+  double extent = 0;
+  for (int t : candidates)
+    for (int v : surface_.triangles[t].nodes) extent = std::max(extent, (positions_[v] - p).norm());
+  const Vec3 far = p + 2 * (extent + 1) * dir;
+  int crossings = 0;
+  for (int t : candidates) {
+    const Tri& n = surface_.triangles[t].nodes;
+    double s;
+    crossings += segment_crosses_triangle(p, far, positions_[n[0]], positions_[n[1]], positions_[n[2]], s);
+  }
+  return crossings % 2 == 1;
+}
+
+}  // namespace stc
