@@ -253,5 +253,21 @@ TEST(HybridModel, SetYoungModulusEqualsFreshPrecompute) {
   std::printf("[ young    ] set_young_modulus vs fresh precompute: S %.2e, all %.2e\n", e_surface, e_all);
 }
 
+TEST(HybridModel, PrecomputeTimingsReported) {
+  const HybridModel h(make_thigh_scene());
+  const auto& t = h.precompute_timings_ms();
+  double parts = 0;
+  for (const char* k : {"partition", "element_stiffness", "condensation_assembly", "condensation_factor",
+                        "condensation_solve", "condensation_products", "recovery_operator",
+                        "hybrid_assembly"}) {
+    ASSERT_TRUE(t.count(k)) << k;
+    EXPECT_GE(t.at(k), 0.0);
+    parts += t.at(k);
+    std::printf("[ precomp  ] %-22s %8.3f ms\n", k, t.at(k));
+  }
+  EXPECT_GE(t.at("total") * (1 + 1e-9), parts);
+  std::printf("[ precomp  ] %-22s %8.3f ms\n", "total", t.at("total"));
+}
+
 }  // namespace
 }  // namespace stc
