@@ -70,7 +70,9 @@ Surface read_stl(const std::string& path, const std::string& data) {
   const bool binary_size_matches =
       data.size() >= 84 &&
       data.size() == 84 + 50ull * load_binary<std::uint32_t>(data.data() + 80, !host_is_little_endian());
-  if (!binary_size_matches && data.compare(0, 5, "solid") == 0) {
+  // Some binary writers also start the header with "solid"; text never holds a NUL byte.
+  const bool text = data.find('\0') == std::string::npos;
+  if (!binary_size_matches && text && data.compare(0, 5, "solid") == 0) {
     TextCursor c(path, data);
     c.line_tokens("solid");
     while (true) {

@@ -87,6 +87,24 @@ RawMesh tetrahedralize_surface(const std::string& path, const Surface& surface,
       f.polygonlist[0].vertexlist[k] = remap[static_cast<std::size_t>(surface.triangles[t][k])];
   }
 
+  // Self-intersections are looked for first with TetGen's -d (detect) mode, which reports them
+  // instead of failing: TetGen 1.5.0 frees its pools twice when a meshing run ends in an error
+  // (terminatetetgen() and ~tetgenmesh() both call freememory()), which crashes the process.
+  {
+    tetgenbehavior detect;
+    char detect_switches[] = "dQ";
+    detect.parse_commandline(detect_switches);
+    tetgenio found;
+    try {
+      tetrahedralize(&detect, &in, &found);
+    } catch (int code) {
+      fail(path, 0, tetgen_error(code));
+    }
+    if (found.numberoftrifaces > 0)
+      fail(path, 0, "the surface intersects itself (" + std::to_string(found.numberoftrifaces) +
+                        " intersecting triangles found by TetGen -d)");
+  }
+
   tetgenbehavior behavior;
   std::vector<char> args(switches.begin(), switches.end());
   args.push_back('\0');

@@ -67,20 +67,21 @@ class VtkLegacyReader {
     const long long n = static_cast<long long>(out_.mesh.nodes.size());
     for (std::size_t i = 0; i < types_.size(); ++i) {
       if (types_[i] != kVtkTetra) continue;
+      const int line = i < cell_lines_.size() ? cell_lines_[i] : cells_line_;
       const long long begin = offsets_[i], end = offsets_[i + 1];
       if (end - begin != 4)
-        fail(c_.path(), cells_line_, "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
+        fail(c_.path(), line, "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
                                          std::to_string(end - begin) + " points");
       Tet tet;
       for (int k = 0; k < 4; ++k) {
         const long long v = conn_[static_cast<std::size_t>(begin + k)];
         if (v < 0 || v >= n)
-          fail(c_.path(), cells_line_, "cell " + std::to_string(i) + " refers to point " +
+          fail(c_.path(), line, "cell " + std::to_string(i) + " refers to point " +
                                            std::to_string(v) + ", out of range [0, " + std::to_string(n) + ")");
         tet[k] = static_cast<int>(v);
       }
       out_.mesh.tets.push_back(tet);
-      out_.lines.tet_line.push_back(i < cell_lines_.size() ? cell_lines_[i] : cells_line_);
+      out_.lines.tet_line.push_back(line);
     }
     return std::move(out_);
   }
