@@ -144,8 +144,12 @@ std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
     const char* disp_ext = eglQueryString(c.display, EGL_EXTENSIONS);
     const bool surfaceless = has_extension(disp_ext, "EGL_KHR_surfaceless_context");
     // Desktop GL 4.3 core first (texelFetch loops, integer textures); GLES 3.2 otherwise.
+    // TISSUE_GL_API=gles skips desktop GL (to test the GLES shader path on any driver).
+    const char* api_env = std::getenv("TISSUE_GL_API");
+    const bool gles_only = api_env && std::string(api_env) == "gles";
     for (GlApi api : {GlApi::DesktopCore, GlApi::Gles32}) {
       const bool desktop = api == GlApi::DesktopCore;
+      if (desktop && gles_only) continue;
       if (!eglBindAPI(desktop ? EGL_OPENGL_API : EGL_OPENGL_ES_API)) continue;
       const EGLint config_attribs[] = {EGL_SURFACE_TYPE, surfaceless ? 0 : EGL_PBUFFER_BIT,
                                        EGL_RENDERABLE_TYPE, desktop ? EGL_OPENGL_BIT : EGL_OPENGL_ES3_BIT,

@@ -56,6 +56,8 @@ class GlSolver final : public LinearSolver {
     const Eigen::Index n = a_.rows();
     CgResult result;
     if (b.size() != n) throw std::invalid_argument("gl solver: b has the wrong size");
+    if (!constrained.empty() && Eigen::Index(constrained.size()) != n)
+      throw std::invalid_argument("gl solver: constrained has the wrong size");
     if (x.size() != n) x = Vector::Zero(n);
     Vector mask = Vector::Ones(n);
     if (!constrained.empty())

@@ -61,8 +61,9 @@ TEST_P(GpuSpmv, ElasticityLikePoisson3D) {
   int passes = 0;
   const double err = spmv_error(a, &passes);
   RecordProperty("relative_error", std::to_string(err));
-  std::printf("[%s] 3D elasticity-like N=%d: rel err %.3g, %d passes\n",
-              layout_name(GetParam()).c_str(), int(a.rows()), err, passes);
+  std::printf("[%s] 3D elasticity-like N=%d: rel err %.3g, %d passes (%s, %s, %s)\n",
+              layout_name(GetParam()).c_str(), int(a.rows()), err, passes,
+              ctx_->renderer().c_str(), ctx_->version().c_str(), ctx_->origin().c_str());
   EXPECT_LE(err, 1e-6);
   EXPECT_EQ(passes, GetParam() == SpmvLayout::MethodA ? 20 : GetParam() == SpmvLayout::MethodB ? 5 : 1);
 }

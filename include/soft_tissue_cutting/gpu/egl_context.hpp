@@ -17,7 +17,7 @@ class EglContext {
  public:
   // Null when no EGL driver/device gives a usable context; *why_not (if given) then holds one
   // line saying why, so the caller can fall back to the CPU solver. TISSUE_FORCE_NO_EGL=1 forces
-  // this path (tests of the fallback).
+  // this path (tests of the fallback); TISSUE_GL_API=gles skips desktop GL.
   static std::unique_ptr<EglContext> create(std::string* why_not);
   ~EglContext();
   EglContext(const EglContext&) = delete;
