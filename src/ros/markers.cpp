@@ -119,15 +119,15 @@ visualization_msgs::MarkerArray scalpel_markers(const std::optional<BladePose>& 
   const Vec3 tip(0, 0, 0), heel(len, 0, 0), back(len, 0, height);
   for (const Vec3& p : {tip, heel, back, tip, back, heel}) b.points.push_back(point(p));
   // Handle: a box continuing the blade beyond its heel.
-  const double handle = 0.06;
+  const double handle = 0.04;
   h.action = visualization_msgs::Marker::ADD;
   BladePose hp = *blade;
   hp.position = blade->position + blade->orientation * Vec3(len + 0.5 * handle, 0, 0.5 * height);
   h.pose = to_pose_msg(hp);
   h.scale.x = handle;
-  h.scale.y = 0.003;
-  h.scale.z = 0.008;
-  h.color = rgba(0.25, 0.35, 0.55);
+  h.scale.y = 0.0025;
+  h.scale.z = 0.005;
+  h.color = rgba(0.45, 0.55, 0.75);
   array.markers = {b, h};
   return array;
 }

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# render_picture.sh BAG PNG [SECONDS]: replays a bag's /tissue/surface and /tissue/markers into
+# rviz (config/tissue.rviz) on a virtual X display and saves a screenshot (RECIPES.md: Xvfb +
+# `import -window root`). Needs the workspace sourced, xvfb-run, rviz and imagemagick.
+set -euo pipefail
+bag="$1" png="$2" wait_s="${3:-}"
+export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
+port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
+export ROS_MASTER_URI="http://localhost:$port"
+if [ -z "${DISPLAY:-}" ] || [ "${TISSUE_RENDER_INNER:-}" != 1 ]; then
+  exec env TISSUE_RENDER_INNER=1 xvfb-run -a -s "-screen 0 1280x1024x24" "$0" "$@"
+fi
+dur=$(/usr/bin/python3 -c "import rosbag,sys; b=rosbag.Bag(sys.argv[1]); print(b.get_end_time()-b.get_start_time())" "$bag")
+# rviz start (~6 s on llvmpipe) + the bag at 2x + settle
+[ -n "$wait_s" ] || wait_s=$(/usr/bin/python3 -c "print(int(6 + $dur / 2 + 5))")
+roslaunch -p "$port" soft_tissue_cutting view_bag.launch bag:="$bag" >"${png%.png}_rviz.log" 2>&1 &
+launch_pid=$!
+sleep "$wait_s"
+import -window root "$png"
+kill -INT "$launch_pid" 2>/dev/null || true
+wait "$launch_pid" 2>/dev/null || true
+echo "picture: $png"
