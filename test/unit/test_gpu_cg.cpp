@@ -164,7 +164,7 @@ TEST(GpuFallback, ForcedNoEglGivesNullAndOneLineReason) {
   EXPECT_NE(why.find("TISSUE_FORCE_NO_EGL"), std::string::npos);
 }
 
-TEST(GpuFallback, MissingShaderDirIsReportedWithThePath) {
+TEST(GpuFallback, BadShaderDirEnvFallsBackToBuildTree) {
   // $TISSUE_SHADER_DIR comes first; the build-tree folder still serves as fallback.
   setenv("TISSUE_SHADER_DIR", "/nonexistent/shaders", 1);
   std::string why;
