@@ -84,12 +84,12 @@ int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int
   auto it = side_.find(v);
   if (it != side_.end()) return it->second;
   const double d = distance(mesh, v);
-  // Snap relative to the LONGEST edge at v, so any edge that still crosses has t in
-  // [snap, 1 - snap] (see CutOptions::snap_tolerance).
+  // Only nodes on the plane up to round-off start as "on"; split_along_triangle snaps the
+  // end of any crossing edge that the plane meets too near it (CutOptions::snap_tolerance).
   double longest = 0;
   for (int t : state.node_tets[v])
     for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
-  const int s = std::abs(d) < snap_tolerance_ * longest ? 0 : (d > 0 ? 1 : -1);
+  const int s = std::abs(d) <= 1e-9 * longest ? 0 : (d > 0 ? 1 : -1);
   side_[v] = s;
   return s;
 }
@@ -132,6 +132,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
   std::map<std::pair<int, int>, double> crossing;
   for (;;) {
     crossing.clear();
+    bool resnap = false;
     for (int t : candidates) {
       const Tet& tet = mesh.tets[t];
       for (const auto& e : kTetEdges) {
@@ -144,9 +145,17 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         const double s = du / (du - dv);
         if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), options.inside_tolerance))
           continue;
+        // Too near an end: that end is on the cut (snapped, never moved), so every edge that
+        // is split has t in [snap, 1 - snap].
+        if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
+          tri.set_on(s < 0.5 ? u : v);
+          resnap = true;
+          continue;
+        }
         crossing[{u, v}] = s;
       }
     }
+    if (resnap) continue;
     bool snapped = false;
     for (int t : candidates) {
       std::vector<Split> splits;

@@ -21,11 +21,12 @@ struct NewNode {
 };
 
 struct CutOptions {
-  // A node whose distance to the cut plane is below snap_tolerance times the LONGEST edge
-  // at the node counts as on the plane (it is never moved). Relative to the longest edge,
-  // every edge that is split has its crossing parameter t in [snap, 1 - snap] (|d_a| >=
-  // snap L_ab and |d_a - d_b| <= L_ab), so each bisection child keeps at least `snap` of
-  // its parent's volume. The price: the cut surface may lie up to snap * h off the blade.
+  // An edge the cut plane crosses at parameter t < snap (or > 1 - snap) is not split: its
+  // nearer end is snapped, i.e. counts as on the plane (it is never moved - moving nodes
+  // would change volume). So every split has t in [snap, 1 - snap] and each bisection child
+  // keeps at least `snap` of its parent's volume. Snapping only where a split would be too
+  // lopsided keeps the cut as close to the blade as this allows: the cut surface lies at
+  // most snap * (edge length) off the blade.
   double snap_tolerance = 0.1;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
