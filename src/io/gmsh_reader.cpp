@@ -15,8 +15,8 @@ constexpr int kGmshTet = 4;
 
 // Nodes per Gmsh element type (needed to skip other element types in binary files).
 int gmsh_nodes_per_element(long long type) {
-  static const int table[] = {0,  2,  3,  4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,
-                              8,  20, 15, 13, 9,  10, 12, 15, 15, 21, 4,  5,  6,  20, 35, 56};
+  static const int table[] = {0, 2,  3,  4,  4, 8,  6,  5,  3,  6,  9, 10, 27, 18, 14, 1,
+                              8, 20, 15, 13, 9, 10, 12, 15, 15, 21, 4, 5,  6,  20, 35, 56};
   if (type >= 1 && type < static_cast<long long>(sizeof(table) / sizeof(table[0])))
     return table[type];
   if (type == 92) return 64;
@@ -42,12 +42,18 @@ class GmshReader {
         read_format();
       } else if (tok == "$Nodes") {
         require_format("$Nodes");
-        if (version_ == 2) read_v2_nodes(); else read_v4_nodes();
+        if (version_ == 2)
+          read_v2_nodes();
+        else
+          read_v4_nodes();
         any_nodes = true;
       } else if (tok == "$Elements") {
         require_format("$Elements");
         if (!any_nodes) c_.fail("$Elements before $Nodes");
-        if (version_ == 2) read_v2_elements(); else read_v4_elements();
+        if (version_ == 2)
+          read_v2_elements();
+        else
+          read_v4_elements();
       } else if (tok.size() > 1 && tok[0] == '$' && tok.substr(0, 4) != "$End" &&
                  tok.substr(0, 4) != "$END") {
         skip_section(tok);
@@ -67,7 +73,8 @@ class GmshReader {
 
   void expect(std::string_view end, const std::string& context) {
     const std::string_view tok = c_.token(std::string(end).c_str());
-    if (tok != end) c_.fail("expected " + std::string(end) + " " + context + ", got " + quoted(tok));
+    if (tok != end)
+      c_.fail("expected " + std::string(end) + " " + context + ", got " + quoted(tok));
   }
 
   void skip_section(std::string_view tok) {
@@ -94,9 +101,12 @@ class GmshReader {
       c_.skip_past_newline();
       // The integer 1 written in the file's byte order tells the endianness.
       const char* p = c_.raw(4, "endianness marker");
-      if (load_binary<std::int32_t>(p, false) == 1) swap_ = false;
-      else if (load_binary<std::int32_t>(p, true) == 1) swap_ = true;
-      else c_.fail("bad binary endianness marker (expected the integer 1)");
+      if (load_binary<std::int32_t>(p, false) == 1)
+        swap_ = false;
+      else if (load_binary<std::int32_t>(p, true) == 1)
+        swap_ = true;
+      else
+        c_.fail("bad binary endianness marker (expected the integer 1)");
     }
     expect("$EndMeshFormat", "after the format line");
   }
@@ -132,7 +142,8 @@ class GmshReader {
     const long long n = c_.integer(what);
     if (n < 0) c_.fail(std::string("negative ") + what + " " + std::to_string(n));
     if (min_bytes_each > 0 && static_cast<unsigned long long>(n) > c_.remaining() / min_bytes_each)
-      c_.fail(std::string(what) + " " + std::to_string(n) + " exceeds what the file holds (truncated?)");
+      c_.fail(std::string(what) + " " + std::to_string(n) +
+              " exceeds what the file holds (truncated?)");
     return n;
   }
 
@@ -168,7 +179,8 @@ class GmshReader {
       const auto tok = c_.line_tokens("an element line");
       const int line = c_.line();
       if (!tok.empty() && tok[0] == "$ENDELM")
-        c_.fail("found $ENDELM after " + std::to_string(i) + " of " + std::to_string(n) + " elements");
+        c_.fail("found $ENDELM after " + std::to_string(i) + " of " + std::to_string(n) +
+                " elements");
       // elm-number elm-type reg-phys reg-elem number-of-nodes node-list
       if (tok.size() < 5) c_.fail("element line has fewer than 5 fields");
       c_.to_integer(tok[0], "element number");
@@ -197,7 +209,8 @@ class GmshReader {
       const long long tag = load_binary<std::int32_t>(p, swap_);
       Vec3 x(load_binary<double>(p + 4, swap_), load_binary<double>(p + 12, swap_),
              load_binary<double>(p + 20, swap_));
-      if (!x.allFinite()) fail(c_.path(), line, "non-finite coordinate of node tag " + std::to_string(tag));
+      if (!x.allFinite())
+        fail(c_.path(), line, "non-finite coordinate of node tag " + std::to_string(tag));
       add_node(tag, x, line);
     }
     expect("$EndNodes", "after the binary node data");
@@ -216,15 +229,18 @@ class GmshReader {
         const long long ntags = load_binary<std::int32_t>(h + 8, swap_);
         const int nn = gmsh_nodes_per_element(type);
         if (nn == 0) c_.fail("unknown element type " + std::to_string(type));
-        if (follow < 1 || follow > n - done) c_.fail("bad element block size " + std::to_string(follow));
+        if (follow < 1 || follow > n - done)
+          c_.fail("bad element block size " + std::to_string(follow));
         if (ntags < 0 || ntags > 1000) c_.fail("bad number of tags " + std::to_string(ntags));
         const std::size_t each = 4 * static_cast<std::size_t>(1 + ntags + nn);
-        if (static_cast<std::size_t>(follow) > c_.remaining() / each) c_.fail("truncated element data");
+        if (static_cast<std::size_t>(follow) > c_.remaining() / each)
+          c_.fail("truncated element data");
         const char* p = c_.raw(each * static_cast<std::size_t>(follow), "element data");
         for (long long e = 0; e < follow; ++e, p += each) {
           if (type != kGmshTet) continue;
           long long tags[4];
-          for (int k = 0; k < 4; ++k) tags[k] = load_binary<std::int32_t>(p + 4 * (1 + ntags + k), swap_);
+          for (int k = 0; k < 4; ++k)
+            tags[k] = load_binary<std::int32_t>(p + 4 * (1 + ntags + k), swap_);
           add_tet(tags, line);
         }
         done += follow;
@@ -235,7 +251,8 @@ class GmshReader {
     for (long long i = 0; i < n; ++i) {
       const auto tok = c_.line_tokens("an element line");
       if (!tok.empty() && tok[0] == "$EndElements")
-        c_.fail("found $EndElements after " + std::to_string(i) + " of " + std::to_string(n) + " elements");
+        c_.fail("found $EndElements after " + std::to_string(i) + " of " + std::to_string(n) +
+                " elements");
       // elm-number elm-type number-of-tags tags... node-list
       if (tok.size() < 3) c_.fail("element line has fewer than 3 fields");
       c_.to_integer(tok[0], "element number");
@@ -290,7 +307,8 @@ class GmshReader {
       }
       if (dim < 0 || dim > 3) c_.fail("bad entity dimension " + std::to_string(dim));
       if (parametric < 0 || parametric > 1) c_.fail("bad parametric flag");
-      if (n > total - seen) c_.fail("node blocks hold more nodes than the declared " + std::to_string(total));
+      if (n > total - seen)
+        c_.fail("node blocks hold more nodes than the declared " + std::to_string(total));
       const int params = parametric ? static_cast<int>(dim) : 0;
       std::vector<long long> tags;
       if (binary_) {
@@ -300,11 +318,13 @@ class GmshReader {
         const char* x = c_.raw(8 * (3 + params) * static_cast<std::size_t>(n), "node coordinates");
         const int line = c_.line();
         for (long long i = 0; i < n; ++i) {
-          const long long tag = static_cast<long long>(load_binary<std::uint64_t>(t + 8 * i, swap_));
+          const long long tag =
+              static_cast<long long>(load_binary<std::uint64_t>(t + 8 * i, swap_));
           const char* q = x + 8 * (3 + params) * i;
           Vec3 v(load_binary<double>(q, swap_), load_binary<double>(q + 8, swap_),
                  load_binary<double>(q + 16, swap_));
-          if (!v.allFinite()) fail(c_.path(), line, "non-finite coordinate of node tag " + std::to_string(tag));
+          if (!v.allFinite())
+            fail(c_.path(), line, "non-finite coordinate of node tag " + std::to_string(tag));
           add_node(tag, v, line);
         }
       } else {
@@ -323,7 +343,8 @@ class GmshReader {
       seen += n;
     }
     if (seen != total)
-      c_.fail("node blocks hold " + std::to_string(seen) + " nodes, header says " + std::to_string(total));
+      c_.fail("node blocks hold " + std::to_string(seen) + " nodes, header says " +
+              std::to_string(total));
     expect("$EndNodes", "after the node blocks");
   }
 
@@ -354,7 +375,8 @@ class GmshReader {
         type = c_.integer("element type");
         n = count("number of elements in block", 4);
       }
-      if (n > total - seen) c_.fail("element blocks hold more elements than the declared " + std::to_string(total));
+      if (n > total - seen)
+        c_.fail("element blocks hold more elements than the declared " + std::to_string(total));
       if (binary_) {
         const int nn = gmsh_nodes_per_element(type);
         if (nn == 0) c_.fail("unknown element type " + std::to_string(type));
@@ -366,15 +388,19 @@ class GmshReader {
           for (long long e = 0; e < n; ++e) {
             long long tags[4];
             for (int k = 0; k < 4; ++k)
-              tags[k] = static_cast<long long>(load_binary<std::uint64_t>(p + each * e + 8 * (1 + k), swap_));
+              tags[k] = static_cast<long long>(
+                  load_binary<std::uint64_t>(p + each * e + 8 * (1 + k), swap_));
             add_tet(tags, line);
           }
       } else {
         for (long long e = 0; e < n; ++e) {
           const auto tok = c_.line_tokens("an element line");
-          if (!tok.empty() && tok[0] == "$EndElements") c_.fail("found $EndElements inside an element block");
+          if (!tok.empty() && tok[0] == "$EndElements")
+            c_.fail("found $EndElements inside an element block");
           if (type != kGmshTet) continue;
-          if (tok.size() != 5) c_.fail("tetrahedron line needs a tag and 4 node tags, has " + std::to_string(tok.size()) + " fields");
+          if (tok.size() != 5)
+            c_.fail("tetrahedron line needs a tag and 4 node tags, has " +
+                    std::to_string(tok.size()) + " fields");
           c_.to_integer(tok[0], "element tag");
           long long tags[4];
           for (int k = 0; k < 4; ++k) tags[k] = c_.to_integer(tok[1 + k], "node tag");
@@ -384,7 +410,8 @@ class GmshReader {
       seen += n;
     }
     if (seen != total)
-      c_.fail("element blocks hold " + std::to_string(seen) + " elements, header says " + std::to_string(total));
+      c_.fail("element blocks hold " + std::to_string(seen) + " elements, header says " +
+              std::to_string(total));
     expect("$EndElements", "after the element blocks");
   }
 

@@ -31,7 +31,8 @@ io::RawMesh read_raw(const std::string& path, const MeshReadOptions& options) {
   if (ext == ".off")
     return io::tetrahedralize_surface(path, io::read_off(path, io::read_file(path)),
                                       options.tetgen_switches);
-  if (ext == ".ele") io::fail(path, 0, "name a TetGen mesh by its .node file (the .ele beside it is read too)");
+  if (ext == ".ele")
+    io::fail(path, 0, "name a TetGen mesh by its .node file (the .ele beside it is read too)");
   io::fail(path, 0,
            "unknown mesh format '" + ext +
                "' (supported: .msh .node .vtk .vtu, closed surfaces .obj .stl .off)");

@@ -13,8 +13,8 @@ namespace {
 void add_polygon(TextCursor& c, Surface& s, const std::vector<long long>& poly) {
   if (poly.size() < 3) c.fail("face with fewer than 3 vertices");
   for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
-    s.triangles.push_back({static_cast<int>(poly[0]), static_cast<int>(poly[k]),
-                           static_cast<int>(poly[k + 1])});
+    s.triangles.push_back(
+        {static_cast<int>(poly[0]), static_cast<int>(poly[k]), static_cast<int>(poly[k + 1])});
     s.triangle_line.push_back(c.line());
   }
 }
@@ -38,8 +38,10 @@ Surface read_obj(const std::string& path, const std::string& data) {
         const std::string_view ref = tok[k].substr(0, tok[k].find('/'));
         long long v = c.to_integer(ref, "vertex index");
         const long long n = static_cast<long long>(s.vertices.size());
-        if (v < 0) v += n;
-        else v -= 1;
+        if (v < 0)
+          v += n;
+        else
+          v -= 1;
         if (v < 0 || v >= n)
           c.fail("vertex index " + std::string(ref) + " out of range (" + std::to_string(n) +
                  " vertices so far)");
@@ -69,7 +71,8 @@ Surface read_stl(const std::string& path, const std::string& data) {
   };
   const bool binary_size_matches =
       data.size() >= 84 &&
-      data.size() == 84 + 50ull * load_binary<std::uint32_t>(data.data() + 80, !host_is_little_endian());
+      data.size() ==
+          84 + 50ull * load_binary<std::uint32_t>(data.data() + 80, !host_is_little_endian());
   // Some binary writers also start the header with "solid"; text never holds a NUL byte.
   const bool text = data.find('\0') == std::string::npos;
   if (!binary_size_matches && text && data.compare(0, 5, "solid") == 0) {
@@ -100,8 +103,9 @@ Surface read_stl(const std::string& path, const std::string& data) {
   }
   if (data.size() < 84) fail(path, 0, "too short for a binary STL and not an ASCII STL");
   if (!binary_size_matches)
-    fail(path, 0, "binary STL size " + std::to_string(data.size()) +
-                      " does not match its triangle count (truncated?)");
+    fail(path, 0,
+         "binary STL size " + std::to_string(data.size()) +
+             " does not match its triangle count (truncated?)");
   const std::uint32_t n = load_binary<std::uint32_t>(data.data() + 80, !host_is_little_endian());
   for (std::uint32_t i = 0; i < n; ++i) {
     const char* p = data.data() + 84 + 50ull * i + 12;  // skip the normal
@@ -143,7 +147,8 @@ Surface read_off(const std::string& path, const std::string& data) {
     for (long long j = 0; j < k; ++j) {
       const long long v = c.to_integer(tok[1 + j], "vertex index");
       if (v < 0 || v >= nv)
-        c.fail("vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(nv) + ")");
+        c.fail("vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(nv) +
+               ")");
       poly.push_back(v);
     }
     add_polygon(c, s, poly);  // extra fields (colours) after the indices are ignored

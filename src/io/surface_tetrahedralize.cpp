@@ -16,18 +16,26 @@ namespace {
 
 std::string tetgen_error(int code) {
   switch (code) {
-    case 1: return "TetGen ran out of memory";
-    case 2: return "TetGen internal error";
-    case 3: return "the surface intersects itself (TetGen)";
-    case 4: return "the surface has a feature too small for TetGen's tolerance";
-    case 5: return "two surface facets are too close together (TetGen)";
-    case 10: return "TetGen rejected the input surface";
-    default: return "TetGen failed with code " + std::to_string(code);
+    case 1:
+      return "TetGen ran out of memory";
+    case 2:
+      return "TetGen internal error";
+    case 3:
+      return "the surface intersects itself (TetGen)";
+    case 4:
+      return "the surface has a feature too small for TetGen's tolerance";
+    case 5:
+      return "two surface facets are too close together (TetGen)";
+    case 10:
+      return "TetGen rejected the input surface";
+    default:
+      return "TetGen failed with code " + std::to_string(code);
   }
 }
 
 void check_closed(const std::string& path, const Surface& s) {
-  if (s.triangles.size() < 4) fail(path, 0, "surface has fewer than 4 triangles: not a closed surface");
+  if (s.triangles.size() < 4)
+    fail(path, 0, "surface has fewer than 4 triangles: not a closed surface");
   std::map<std::pair<int, int>, std::pair<int, int>> edges;  // edge -> (uses, first triangle)
   for (std::size_t t = 0; t < s.triangles.size(); ++t) {
     const Tri& tri = s.triangles[t];
@@ -101,8 +109,9 @@ RawMesh tetrahedralize_surface(const std::string& path, const Surface& surface,
       fail(path, 0, tetgen_error(code));
     }
     if (found.numberoftrifaces > 0)
-      fail(path, 0, "the surface intersects itself (" + std::to_string(found.numberoftrifaces) +
-                        " intersecting triangles found by TetGen -d)");
+      fail(path, 0,
+           "the surface intersects itself (" + std::to_string(found.numberoftrifaces) +
+               " intersecting triangles found by TetGen -d)");
   }
 
   tetgenbehavior behavior;
@@ -121,11 +130,13 @@ RawMesh tetrahedralize_surface(const std::string& path, const Surface& surface,
   RawMesh raw;
   raw.mesh.nodes.reserve(static_cast<std::size_t>(out.numberofpoints));
   for (int i = 0; i < out.numberofpoints; ++i)
-    raw.mesh.nodes.emplace_back(out.pointlist[3 * i], out.pointlist[3 * i + 1], out.pointlist[3 * i + 2]);
+    raw.mesh.nodes.emplace_back(out.pointlist[3 * i], out.pointlist[3 * i + 1],
+                                out.pointlist[3 * i + 2]);
   raw.mesh.tets.reserve(static_cast<std::size_t>(out.numberoftetrahedra));
   for (int t = 0; t < out.numberoftetrahedra; ++t) {
     Tet tet;
-    for (int k = 0; k < 4; ++k) tet[k] = out.tetrahedronlist[t * out.numberofcorners + k] - out.firstnumber;
+    for (int k = 0; k < 4; ++k)
+      tet[k] = out.tetrahedronlist[t * out.numberofcorners + k] - out.firstnumber;
     bool in_range = true;
     for (int v : tet) in_range &= v >= 0 && v < out.numberofpoints;
     // TetGen's own orientation convention is the mirror of ours: orient each tet positively

@@ -38,13 +38,15 @@ RawMesh read_tetgen(const std::string& node_path) {
              std::to_string(4 + attributes + markers));
     const long long index = c.to_integer(tok[0], "point index");
     if (i == 0) {
-      if (index != 0 && index != 1) c.fail("first point index must be 0 or 1, got " + std::to_string(index));
+      if (index != 0 && index != 1)
+        c.fail("first point index must be 0 or 1, got " + std::to_string(index));
       base = index;
     } else if (index != base + i) {
       c.fail("points must be numbered consecutively: expected " + std::to_string(base + i) +
              ", got " + std::to_string(index));
     }
-    out.mesh.nodes.emplace_back(c.to_real(tok[1], "x coordinate"), c.to_real(tok[2], "y coordinate"),
+    out.mesh.nodes.emplace_back(c.to_real(tok[1], "x coordinate"),
+                                c.to_real(tok[2], "y coordinate"),
                                 c.to_real(tok[3], "z coordinate"));
     out.lines.node_line.push_back(c.line());
   }
@@ -77,8 +79,8 @@ RawMesh read_tetgen(const std::string& node_path) {
     for (int k = 0; k < 4; ++k) {  // the first four are the corners (also for 10-node tets)
       const long long v = e.to_integer(tok[1 + k], "node index");
       if (v < base || v >= base + n)
-        e.fail("node index " + std::to_string(v) + " out of range [" + std::to_string(base) +
-               ", " + std::to_string(base + n - 1) + "]");
+        e.fail("node index " + std::to_string(v) + " out of range [" + std::to_string(base) + ", " +
+               std::to_string(base + n - 1) + "]");
       tet[k] = static_cast<int>(v - base);
     }
     out.mesh.tets.push_back(tet);

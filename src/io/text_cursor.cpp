@@ -142,13 +142,15 @@ std::string_view TextCursor::rest_of_line() {
 
 long long TextCursor::to_integer(std::string_view tok, const char* what) {
   long long v = 0;
-  if (!parse_int(tok, v)) fail(std::string("expected ") + what + " (an integer), got " + quoted(tok));
+  if (!parse_int(tok, v))
+    fail(std::string("expected ") + what + " (an integer), got " + quoted(tok));
   return v;
 }
 
 double TextCursor::to_real(std::string_view tok, const char* what) {
   double v = 0;
-  if (!parse_double(tok, v)) fail(std::string("expected ") + what + " (a number), got " + quoted(tok));
+  if (!parse_double(tok, v))
+    fail(std::string("expected ") + what + " (a number), got " + quoted(tok));
   if (!std::isfinite(v)) fail(std::string("non-finite ") + what + " " + quoted(tok));
   return v;
 }

@@ -77,7 +77,8 @@ class TextCursor {
 template <typename T>
 T load_binary(const char* p, bool swap) {
   unsigned char b[sizeof(T)];
-  for (std::size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<unsigned char>(p[swap ? sizeof(T) - 1 - i : i]);
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    b[i] = static_cast<unsigned char>(p[swap ? sizeof(T) - 1 - i : i]);
   T v;
   __builtin_memcpy(&v, b, sizeof(T));
   return v;

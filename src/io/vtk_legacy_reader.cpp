@@ -23,11 +23,14 @@ class VtkLegacyReader {
     double version = 0;
     if (!parse_double(v, version)) c_.fail("bad VTK version " + quoted(v));
     new_layout_ = version >= 5.0;  // 5.1 writes CELLS as OFFSETS + CONNECTIVITY
-    c_.rest_of_line();  // title
+    c_.rest_of_line();             // title
     const std::string_view mode = c_.rest_of_line();
-    if (mode == "ASCII") binary_ = false;
-    else if (mode == "BINARY") binary_ = true;
-    else c_.fail("third line must be ASCII or BINARY, got " + quoted(mode));
+    if (mode == "ASCII")
+      binary_ = false;
+    else if (mode == "BINARY")
+      binary_ = true;
+    else
+      c_.fail("third line must be ASCII or BINARY, got " + quoted(mode));
     expect_word("DATASET");
     const std::string_view type = c_.token("a dataset type");
     if (type != "UNSTRUCTURED_GRID")
@@ -70,14 +73,16 @@ class VtkLegacyReader {
       const int line = i < cell_lines_.size() ? cell_lines_[i] : cells_line_;
       const long long begin = offsets_[i], end = offsets_[i + 1];
       if (end - begin != 4)
-        fail(c_.path(), line, "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
-                                         std::to_string(end - begin) + " points");
+        fail(c_.path(), line,
+             "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
+                 std::to_string(end - begin) + " points");
       Tet tet;
       for (int k = 0; k < 4; ++k) {
         const long long v = conn_[static_cast<std::size_t>(begin + k)];
         if (v < 0 || v >= n)
-          fail(c_.path(), line, "cell " + std::to_string(i) + " refers to point " +
-                                           std::to_string(v) + ", out of range [0, " + std::to_string(n) + ")");
+          fail(c_.path(), line,
+               "cell " + std::to_string(i) + " refers to point " + std::to_string(v) +
+                   ", out of range [0, " + std::to_string(n) + ")");
         tet[k] = static_cast<int>(v);
       }
       out_.mesh.tets.push_back(tet);
@@ -96,7 +101,8 @@ class VtkLegacyReader {
     const long long n = c_.integer(what);
     if (n < 0) c_.fail(std::string("negative ") + what);
     if (static_cast<unsigned long long>(n) > c_.remaining())
-      c_.fail(std::string(what) + " " + std::to_string(n) + " exceeds what the file holds (truncated?)");
+      c_.fail(std::string(what) + " " + std::to_string(n) +
+              " exceeds what the file holds (truncated?)");
     return n;
   }
 
@@ -127,13 +133,17 @@ class VtkLegacyReader {
     const long long n = count("number of points");
     const std::string_view type = c_.token("point data type");
     int bytes = 0;
-    if (type == "float") bytes = 4;
-    else if (type == "double") bytes = 8;
-    else c_.fail("POINTS type must be float or double, got " + quoted(type));
+    if (type == "float")
+      bytes = 4;
+    else if (type == "double")
+      bytes = 8;
+    else
+      c_.fail("POINTS type must be float or double, got " + quoted(type));
     out_.mesh.nodes.reserve(static_cast<std::size_t>(n));
     if (binary_) {
       c_.skip_past_newline();
-      if (static_cast<unsigned long long>(n) > c_.remaining() / (3u * bytes)) c_.fail("truncated binary POINTS");
+      if (static_cast<unsigned long long>(n) > c_.remaining() / (3u * bytes))
+        c_.fail("truncated binary POINTS");
       const char* p = c_.raw(static_cast<std::size_t>(n) * 3 * bytes, "POINTS");
       const int line = c_.line();
       for (long long i = 0; i < 3 * n; i += 3) {
@@ -141,7 +151,8 @@ class VtkLegacyReader {
         for (int k = 0; k < 3; ++k)
           x[k] = bytes == 4 ? load_binary<float>(p + 4 * (i + k), swap_)
                             : load_binary<double>(p + 8 * (i + k), swap_);
-        if (!x.allFinite()) fail(c_.path(), line, "non-finite coordinate of point " + std::to_string(i / 3));
+        if (!x.allFinite())
+          fail(c_.path(), line, "non-finite coordinate of point " + std::to_string(i / 3));
         out_.mesh.nodes.push_back(x);
         out_.lines.node_line.push_back(line);
       }
@@ -185,19 +196,25 @@ class VtkLegacyReader {
     std::size_t at = 0;
     for (long long i = 0; i < a; ++i) {
       if (at >= all.size())
-        fail(c_.path(), cells_line_, "CELLS size " + std::to_string(b) + " too small for " + std::to_string(a) + " cells");
+        fail(c_.path(), cells_line_,
+             "CELLS size " + std::to_string(b) + " too small for " + std::to_string(a) + " cells");
       const long long k = all[at];
       if (k < 1 || static_cast<std::size_t>(k) > all.size() - at - 1)
-        fail(c_.path(), cells_line_, "cell " + std::to_string(i) + " has a bad point count " + std::to_string(k));
-      conn_.insert(conn_.end(), all.begin() + static_cast<long>(at + 1), all.begin() + static_cast<long>(at + 1 + k));
+        fail(c_.path(), cells_line_,
+             "cell " + std::to_string(i) + " has a bad point count " + std::to_string(k));
+      conn_.insert(conn_.end(), all.begin() + static_cast<long>(at + 1),
+                   all.begin() + static_cast<long>(at + 1 + k));
       offsets_.push_back(static_cast<long long>(conn_.size()));
       at += static_cast<std::size_t>(k) + 1;
     }
     if (at != all.size())
-      fail(c_.path(), cells_line_, "CELLS size " + std::to_string(b) + " does not match the cell list (" + std::to_string(at) + " integers)");
+      fail(c_.path(), cells_line_,
+           "CELLS size " + std::to_string(b) + " does not match the cell list (" +
+               std::to_string(at) + " integers)");
     if (!binary_) {
       // ASCII: one line per cell in practice; remember it for messages.
-      for (long long i = 0; i < a; ++i) cell_lines_.push_back(cells_line_ + 1 + static_cast<int>(i));
+      for (long long i = 0; i < a; ++i)
+        cell_lines_.push_back(cells_line_ + 1 + static_cast<int>(i));
     }
   }
 

@@ -37,7 +37,8 @@ void write_vtk(const std::string& path, const TetMesh& mesh, const Eigen::Vector
   }
   std::fprintf(f, "CELL_DATA %ld\nSCALARS region int 1\nLOOKUP_TABLE default\n", m);
   for (long t = 0; t < m; ++t)
-    std::fprintf(f, "%d\n", tet_region.empty() ? 0 : (tet_region[static_cast<std::size_t>(t)] ? 1 : 0));
+    std::fprintf(f, "%d\n",
+                 tet_region.empty() ? 0 : (tet_region[static_cast<std::size_t>(t)] ? 1 : 0));
   const bool write_failed = std::ferror(f) != 0;
   if (std::fclose(file.release()) != 0 || write_failed)
     throw MeshError(path + ": write failed (disk full or I/O error)");

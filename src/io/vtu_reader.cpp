@@ -56,8 +56,8 @@ class XmlScanner {
 
  private:
   static bool is_name_char(char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '_' || c == ':' || c == '-' || c == '.';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == ':' || c == '-' || c == '.';
   }
   static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
@@ -129,9 +129,11 @@ std::string attribute(const Tag& t, const char* key) {
 RawMesh read_vtu(const std::string& path, const std::string& data) {
   XmlScanner xml(path, data);
   Tag tag;
-  if (!xml.next(tag) || tag.name != "VTKFile") fail(path, tag.line, "not a VTK XML file (no <VTKFile>)");
+  if (!xml.next(tag) || tag.name != "VTKFile")
+    fail(path, tag.line, "not a VTK XML file (no <VTKFile>)");
   if (attribute(tag, "type") != "UnstructuredGrid")
-    fail(path, tag.line, "VTKFile type must be UnstructuredGrid, got " + quoted(attribute(tag, "type")));
+    fail(path, tag.line,
+         "VTKFile type must be UnstructuredGrid, got " + quoted(attribute(tag, "type")));
   if (!attribute(tag, "compressor").empty())
     fail(path, tag.line, "compressed .vtu files are not supported (write ascii DataArrays)");
   long long num_points = -1, num_cells = -1;
@@ -165,16 +167,21 @@ RawMesh read_vtu(const std::string& path, const std::string& data) {
         (stack.back() == "Points" || stack.back() == "Cells")) {
       Array* target = nullptr;
       const std::string name = attribute(tag, "Name");
-      if (stack.back() == "Points") target = &points;
-      else if (name == "connectivity") target = &connectivity;
-      else if (name == "offsets") target = &offsets;
-      else if (name == "types") target = &types;
+      if (stack.back() == "Points")
+        target = &points;
+      else if (name == "connectivity")
+        target = &connectivity;
+      else if (name == "offsets")
+        target = &offsets;
+      else if (name == "types")
+        target = &types;
       if (target) {
         if (target->present) fail(path, tag.line, "duplicate DataArray " + quoted(name));
         const std::string format = attribute(tag, "format");
         if (format != "ascii")
-          fail(path, tag.line, "DataArray " + quoted(name) + " has format " + quoted(format) +
-                                   "; only ascii is supported");
+          fail(path, tag.line,
+               "DataArray " + quoted(name) + " has format " + quoted(format) +
+                   "; only ascii is supported");
         if (target == &points && attribute(tag, "NumberOfComponents") != "3")
           fail(path, tag.line, "Points DataArray must have NumberOfComponents=\"3\"");
         const std::size_t end = data.find("</DataArray", tag.end);
@@ -229,7 +236,8 @@ RawMesh read_vtu(const std::string& path, const std::string& data) {
   long long conn_size = off.empty() ? 0 : off.back();
   if (conn_size < 0 || static_cast<unsigned long long>(conn_size) > data.size())
     fail(path, connectivity.line, "bad last offset " + std::to_string(conn_size));
-  const std::vector<long long> conn = read_ints(connectivity, conn_size, "connectivity index", nullptr);
+  const std::vector<long long> conn =
+      read_ints(connectivity, conn_size, "connectivity index", nullptr);
   long long prev = 0;
   for (long long i = 0; i < num_cells; ++i) {
     const long long end = off[static_cast<std::size_t>(i)];
@@ -237,15 +245,16 @@ RawMesh read_vtu(const std::string& path, const std::string& data) {
     if (end < prev) fail(path, line, "offsets decrease at cell " + std::to_string(i));
     if (type[static_cast<std::size_t>(i)] == 10) {
       if (end - prev != 4)
-        fail(path, line, "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
-                             std::to_string(end - prev) + " points");
+        fail(path, line,
+             "cell " + std::to_string(i) + " is a tetrahedron (type 10) with " +
+                 std::to_string(end - prev) + " points");
       Tet t;
       for (int k = 0; k < 4; ++k) {
         const long long v = conn[static_cast<std::size_t>(prev + k)];
         if (v < 0 || v >= num_points)
-          fail(path, connectivity.line, "cell " + std::to_string(i) + " refers to point " +
-                                            std::to_string(v) + ", out of range [0, " +
-                                            std::to_string(num_points) + ")");
+          fail(path, connectivity.line,
+               "cell " + std::to_string(i) + " refers to point " + std::to_string(v) +
+                   ", out of range [0, " + std::to_string(num_points) + ")");
         t[k] = static_cast<int>(v);
       }
       out.mesh.tets.push_back(t);

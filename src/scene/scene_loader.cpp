@@ -42,8 +42,9 @@ class SceneLoader {
                        ": YAML syntax error: " + e.msg);
     }
     if (!root.IsDefined() || root.IsNull()) throw SceneError(path_ + ": scene file is empty");
-    f_.check_map(root, "", {"mesh", "material", "fixed", "loads", "gravity", "operation_region",
-                            "scalpel", "trajectory", "solver"});
+    f_.check_map(root, "",
+                 {"mesh", "material", "fixed", "loads", "gravity", "operation_region", "scalpel",
+                  "trajectory", "solver"});
     scene_.source = path_;
     if (!root["mesh"]) f_.fail(root, "mesh", "missing (a mesh file or generator is required)");
     load_mesh(root["mesh"]);
@@ -74,8 +75,10 @@ class SceneLoader {
       if (m["tetgen"]["switches"])
         scene_.tetgen_switches = f_.string(m["tetgen"]["switches"], "mesh.tetgen.switches");
     }
-    if (m["file"]) load_mesh_file(m["file"]);
-    else load_generator(m["generator"]);
+    if (m["file"])
+      load_mesh_file(m["file"]);
+    else
+      load_generator(m["generator"]);
 
     if (scene_.scale != 1.0) {
       for (Vec3& x : scene_.mesh.nodes) x *= scene_.scale;
@@ -115,7 +118,8 @@ class SceneLoader {
     p.type = f_.string(g["type"], "mesh.generator.type");
     const std::string k = "mesh.generator.";
     if (p.type == "thigh") {
-      f_.check_map(g, "mesh.generator", {"type", "inner_radius", "outer_radius", "length", "resolution"});
+      f_.check_map(g, "mesh.generator",
+                   {"type", "inner_radius", "outer_radius", "length", "resolution"});
       if (g["inner_radius"]) p.inner_radius = f_.positive(g["inner_radius"], k + "inner_radius");
       if (g["outer_radius"]) p.outer_radius = f_.positive(g["outer_radius"], k + "outer_radius");
       if (g["length"]) p.length = f_.positive(g["length"], k + "length");
@@ -137,7 +141,8 @@ class SceneLoader {
       }
       if (g["cells"]) {
         const YAML::Node c = g["cells"];
-        if (!c.IsSequence() || c.size() != 3) f_.fail(c, k + "cells", "expected a list of 3 integers");
+        if (!c.IsSequence() || c.size() != 3)
+          f_.fail(c, k + "cells", "expected a list of 3 integers");
         for (std::size_t d = 0; d < 3; ++d)
           p.cells[d] = static_cast<int>(
               f_.integer(c[d], k + "cells[" + std::to_string(d) + "]", 1, 1000000));
@@ -159,11 +164,13 @@ class SceneLoader {
   void load_material(const YAML::Node& m) {
     f_.check_map(m, "material", {"young_modulus", "poisson_ratio", "density"});
     Material& mat = scene_.material;
-    if (m["young_modulus"]) mat.young_modulus = f_.positive(m["young_modulus"], "material.young_modulus");
+    if (m["young_modulus"])
+      mat.young_modulus = f_.positive(m["young_modulus"], "material.young_modulus");
     if (m["poisson_ratio"]) {
       mat.poisson_ratio = f_.number(m["poisson_ratio"], "material.poisson_ratio");
       if (!(mat.poisson_ratio > -1.0 && mat.poisson_ratio < 0.5))
-        f_.fail(m["poisson_ratio"], "material.poisson_ratio", "must lie in (-1, 0.5), got " + m["poisson_ratio"].Scalar());
+        f_.fail(m["poisson_ratio"], "material.poisson_ratio",
+                "must lie in (-1, 0.5), got " + m["poisson_ratio"].Scalar());
     }
     if (m["density"]) mat.density = f_.non_negative(m["density"], "material.density");
   }
@@ -181,8 +188,8 @@ class SceneLoader {
       if (!list.IsSequence() || list.size() == 0)
         f_.fail(list, key + ".nodes", "expected a non-empty list of node indices");
       for (std::size_t i = 0; i < list.size(); ++i)
-        s.nodes.push_back(static_cast<int>(f_.integer(list[i], key + ".nodes[" + std::to_string(i) + "]",
-                                                      0, scene_.mesh.num_nodes() - 1)));
+        s.nodes.push_back(static_cast<int>(f_.integer(
+            list[i], key + ".nodes[" + std::to_string(i) + "]", 0, scene_.mesh.num_nodes() - 1)));
     } else if (n["box"]) {
       s.kind = NodeSelector::Kind::kBox;
       s.box = box(n["box"], key + ".box");
@@ -198,7 +205,8 @@ class SceneLoader {
     f_.check_map(n, key, {"min", "max"});
     if (!n["min"] || !n["max"]) f_.fail(n, key, "needs `min` and `max`");
     Box b{f_.vec3(n["min"], key + ".min"), f_.vec3(n["max"], key + ".max")};
-    if (!(b.min.array() <= b.max.array()).all()) f_.fail(n, key, "min must be <= max in every axis");
+    if (!(b.min.array() <= b.max.array()).all())
+      f_.fail(n, key, "min must be <= max in every axis");
     return b;
   }
 
@@ -215,7 +223,8 @@ class SceneLoader {
               "no fixed node: at least one is needed, otherwise the model floats");
     if (!list.IsSequence()) f_.fail(list, "fixed", "expected a list of node selectors");
     for (std::size_t i = 0; i < list.size(); ++i)
-      scene_.fixed.push_back(selector(list[i], "fixed[" + std::to_string(i) + "]", {"nodes", "box", "sphere"}));
+      scene_.fixed.push_back(
+          selector(list[i], "fixed[" + std::to_string(i) + "]", {"nodes", "box", "sphere"}));
   }
 
   void load_loads(const YAML::Node& list) {
@@ -238,9 +247,13 @@ class SceneLoader {
     OperationRegion& r = scene_.operation_region;
     if (n.IsScalar()) {
       const std::string v = n.Scalar();
-      if (v == "all") r.kind = OperationRegion::Kind::kAll;
-      else if (v == "none") r.kind = OperationRegion::Kind::kNone;
-      else f_.fail(n, "operation_region", "expected all, none, {sphere: ...} or {box: ...}, got '" + v + "'");
+      if (v == "all")
+        r.kind = OperationRegion::Kind::kAll;
+      else if (v == "none")
+        r.kind = OperationRegion::Kind::kNone;
+      else
+        f_.fail(n, "operation_region",
+                "expected all, none, {sphere: ...} or {box: ...}, got '" + v + "'");
       return;
     }
     f_.check_map(n, "operation_region", {"sphere", "box"});
@@ -259,13 +272,17 @@ class SceneLoader {
       for (int v : scene_.mesh.tets[t]) c += scene_.mesh.nodes[v];
       any = r.contains(c / 4.0);
     }
-    if (!any) f_.fail(n, "operation_region", "contains no element centroid (use `none` for no operation part)");
+    if (!any)
+      f_.fail(n, "operation_region",
+              "contains no element centroid (use `none` for no operation part)");
   }
 
   void load_scalpel(const YAML::Node& n) {
     f_.check_map(n, "scalpel", {"blade_length", "cut_pressure"});
-    if (n["blade_length"]) scene_.scalpel.blade_length = f_.positive(n["blade_length"], "scalpel.blade_length");
-    if (n["cut_pressure"]) scene_.scalpel.cut_pressure = f_.non_negative(n["cut_pressure"], "scalpel.cut_pressure");
+    if (n["blade_length"])
+      scene_.scalpel.blade_length = f_.positive(n["blade_length"], "scalpel.blade_length");
+    if (n["cut_pressure"])
+      scene_.scalpel.cut_pressure = f_.non_negative(n["cut_pressure"], "scalpel.cut_pressure");
   }
 
   void load_trajectory(const YAML::Node& list) {
@@ -297,7 +314,8 @@ class SceneLoader {
     f_.check_map(n, "solver", {"backend", "tolerance", "max_iterations"});
     if (n["backend"]) {
       const std::string b = f_.string(n["backend"], "solver.backend");
-      if (b != "cpu" && b != "gl") f_.fail(n["backend"], "solver.backend", "must be cpu or gl, got '" + b + "'");
+      if (b != "cpu" && b != "gl")
+        f_.fail(n["backend"], "solver.backend", "must be cpu or gl, got '" + b + "'");
       scene_.solver.backend = b;
     }
     if (n["tolerance"]) scene_.solver.tolerance = f_.positive(n["tolerance"], "solver.tolerance");
@@ -322,7 +340,8 @@ Scene load_scene(const std::string& path_or_builtin) {
   } catch (const YAML::Exception& e) {
     // yaml-cpp conversions we did not anticipate still become one clear line.
     throw SceneError(path_or_builtin +
-                     (e.mark.is_null() ? "" : ":" + std::to_string(e.mark.line + 1)) + ": " + e.msg);
+                     (e.mark.is_null() ? "" : ":" + std::to_string(e.mark.line + 1)) + ": " +
+                     e.msg);
   } catch (const std::bad_alloc&) {
     throw SceneError(path_or_builtin + ": out of memory while loading the scene");
   }

@@ -55,7 +55,8 @@ int Fields::count_present(const YAML::Node& map, std::initializer_list<const cha
 
 double Fields::number(const YAML::Node& node, const std::string& key) const {
   // Quoted scalars are strings, not numbers (tag "!").
-  if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected a number, got " + describe(node));
+  if (!node.IsScalar() || node.Tag() == "!")
+    fail(node, key, "expected a number, got " + describe(node));
   std::string s = node.Scalar();
   const std::string low = [&] {
     std::string l = s;
@@ -89,7 +90,8 @@ double Fields::non_negative(const YAML::Node& node, const std::string& key) cons
 
 long long Fields::integer(const YAML::Node& node, const std::string& key, long long lo,
                           long long hi) const {
-  if (!node.IsScalar() || node.Tag() == "!") fail(node, key, "expected an integer, got " + describe(node));
+  if (!node.IsScalar() || node.Tag() == "!")
+    fail(node, key, "expected an integer, got " + describe(node));
   std::string_view v = node.Scalar();
   if (!v.empty() && v[0] == '+') v.remove_prefix(1);
   long long out = 0;
@@ -97,8 +99,9 @@ long long Fields::integer(const YAML::Node& node, const std::string& key, long l
   if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size())
     fail(node, key, "expected an integer, got " + describe(node));
   if (out < lo || out > hi)
-    fail(node, key, std::to_string(out) + " out of range [" + std::to_string(lo) + ", " +
-                        std::to_string(hi) + "]");
+    fail(node, key,
+         std::to_string(out) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) +
+             "]");
   return out;
 }
 
@@ -110,9 +113,9 @@ std::string Fields::string(const YAML::Node& node, const std::string& key) const
 std::vector<double> Fields::numbers(const YAML::Node& node, const std::string& key,
                                     std::size_t count) const {
   if (!node.IsSequence() || node.size() != count)
-    fail(node, key, "expected a list of " + std::to_string(count) + " numbers, got " +
-                        (node.IsSequence() ? "a list of " + std::to_string(node.size())
-                                           : describe(node)));
+    fail(node, key,
+         "expected a list of " + std::to_string(count) + " numbers, got " +
+             (node.IsSequence() ? "a list of " + std::to_string(node.size()) : describe(node)));
   std::vector<double> out;
   for (std::size_t i = 0; i < count; ++i)
     out.push_back(number(node[i], key + "[" + std::to_string(i) + "]"));

@@ -29,8 +29,8 @@ class Fields {
   // How many of `keys` the map has.
   int count_present(const YAML::Node& map, std::initializer_list<const char*> keys) const;
 
-  double number(const YAML::Node& node, const std::string& key) const;  // finite
-  double positive(const YAML::Node& node, const std::string& key) const;     // > 0
+  double number(const YAML::Node& node, const std::string& key) const;        // finite
+  double positive(const YAML::Node& node, const std::string& key) const;      // > 0
   double non_negative(const YAML::Node& node, const std::string& key) const;  // >= 0
   long long integer(const YAML::Node& node, const std::string& key, long long lo,
                     long long hi) const;

@@ -47,9 +47,12 @@ INSTANTIATE_TEST_SUITE_P(
         FormatCase{"gmsh22bin", "a.msh", [](const TetMesh& m) { return test::gmsh_v22_binary(m); }},
         FormatCase{"gmsh41bin", "a.msh", [](const TetMesh& m) { return test::gmsh_v41_binary(m); }},
         FormatCase{"vtk_ascii", "a.vtk", [](const TetMesh& m) { return test::vtk_ascii(m); }},
-        FormatCase{"vtk51_ascii", "a.VTK", [](const TetMesh& m) { return test::vtk_ascii(m, true); }},
-        FormatCase{"vtk_bin_double", "a.vtk", [](const TetMesh& m) { return test::vtk_binary(m, false); }},
-        FormatCase{"vtk_bin_float", "a.vtk", [](const TetMesh& m) { return test::vtk_binary(m, true); }},
+        FormatCase{"vtk51_ascii", "a.VTK",
+                   [](const TetMesh& m) { return test::vtk_ascii(m, true); }},
+        FormatCase{"vtk_bin_double", "a.vtk",
+                   [](const TetMesh& m) { return test::vtk_binary(m, false); }},
+        FormatCase{"vtk_bin_float", "a.vtk",
+                   [](const TetMesh& m) { return test::vtk_binary(m, true); }},
         FormatCase{"vtu", "a.vtu", [](const TetMesh& m) { return test::vtu_ascii(m); }}),
     [](const ::testing::TestParamInfo<FormatCase>& info) { return std::string(info.param.name); });
 
@@ -103,7 +106,8 @@ class TetrahedralizesSurfaces : public ::testing::TestWithParam<SurfaceCase> {};
 
 TEST_P(TetrahedralizesSurfaces, BoxVolume) {
   TempDir dir;
-  const std::string path = write_file(dir.file(GetParam().file), GetParam().make(test::small_box()));
+  const std::string path =
+      write_file(dir.file(GetParam().file), GetParam().make(test::small_box()));
   std::vector<std::string> warnings;
   const TetMesh mesh = read_mesh(path, {}, &warnings);
   EXPECT_TRUE(warnings.empty());
@@ -116,13 +120,14 @@ TEST_P(TetrahedralizesSurfaces, BoxVolume) {
   EXPECT_EQ(mesh.nodes[0], test::small_box().nodes[0]);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Surfaces, TetrahedralizesSurfaces,
-    ::testing::Values(SurfaceCase{"obj", "s.obj", test::obj_surface},
-                      SurfaceCase{"off", "s.off", test::off_surface},
-                      SurfaceCase{"stl_ascii", "s.stl", test::stl_ascii},
-                      SurfaceCase{"stl_binary", "s.STL", test::stl_binary}),
-    [](const ::testing::TestParamInfo<SurfaceCase>& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Surfaces, TetrahedralizesSurfaces,
+                         ::testing::Values(SurfaceCase{"obj", "s.obj", test::obj_surface},
+                                           SurfaceCase{"off", "s.off", test::off_surface},
+                                           SurfaceCase{"stl_ascii", "s.stl", test::stl_ascii},
+                                           SurfaceCase{"stl_binary", "s.STL", test::stl_binary}),
+                         [](const ::testing::TestParamInfo<SurfaceCase>& info) {
+                           return std::string(info.param.name);
+                         });
 
 TEST(SurfaceReader, SofaLiver2Obj) {
   MeshReadOptions options;
@@ -145,12 +150,14 @@ TEST(VtkWriter, RoundTripIsBitExact) {
   expect_same(read_mesh(path), mesh);
   const std::string text = test::read_text(path);
   EXPECT_EQ(text.rfind("# vtk DataFile Version 3.0\n", 0), 0u);
-  EXPECT_NE(text.find("\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 181 double\n"), std::string::npos);
+  EXPECT_NE(text.find("\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 181 double\n"),
+            std::string::npos);
   EXPECT_NE(text.find("\nCELLS 596 2980\n"), std::string::npos);
   EXPECT_NE(text.find("\nCELL_TYPES 596\n10\n"), std::string::npos);
   EXPECT_NE(text.find("\nPOINT_DATA 181\nVECTORS displacement double\n-0.001 "), std::string::npos);
-  EXPECT_NE(text.find("\nCELL_DATA 596\nSCALARS region int 1\nLOOKUP_TABLE default\n0\n0\n0\n1\n0\n"),
-            std::string::npos);
+  EXPECT_NE(
+      text.find("\nCELL_DATA 596\nSCALARS region int 1\nLOOKUP_TABLE default\n0\n0\n0\n1\n0\n"),
+      std::string::npos);
 }
 
 TEST(VtkWriter, RefusesBadSizesAndUnwritablePaths) {

@@ -6,7 +6,8 @@ namespace {
 
 TEST(GmshReader, SofaLiverV1) {
   std::vector<std::string> warnings;
-  const TetMesh mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver.msh", {}, &warnings);
+  const TetMesh mesh =
+      read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver.msh", {}, &warnings);
   EXPECT_EQ(mesh.num_nodes(), 181);
   EXPECT_EQ(mesh.num_tets(), 596);
   EXPECT_EQ(mesh.nodes[0], Vec3(-0.979259, 2.23512, 2.61245));

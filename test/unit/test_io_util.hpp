@@ -86,7 +86,9 @@ inline std::string gmsh_v1(const TetMesh& m, int tag0 = 1) {
 }
 
 inline std::string gmsh_v22(const TetMesh& m, int tag0 = 1) {
-  std::string s = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"tissue\"\n$EndPhysicalNames\n";
+  std::string s =
+      "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 "
+      "\"tissue\"\n$EndPhysicalNames\n";
   s += "$Nodes\n" + std::to_string(m.num_nodes()) + "\n";
   for (int i = 0; i < m.num_nodes(); ++i)
     s += std::to_string(tag0 + 10 * i) + " " + fmt(m.nodes[i].x()) + " " + fmt(m.nodes[i].y()) +
@@ -108,7 +110,8 @@ inline std::string gmsh_v41(const TetMesh& m) {
   const int n = m.num_nodes();
   const int half = n / 2;
   auto tag = [&](int i) { return 1000 - i; };
-  std::string s = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n";
+  std::string s =
+      "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n";
   s += "$Nodes\n2 " + std::to_string(n) + " " + std::to_string(tag(n - 1)) + " 1000\n";
   s += "1 1 1 " + std::to_string(half) + "\n";
   for (int i = 0; i < half; ++i) s += std::to_string(tag(i)) + "\n";
@@ -136,7 +139,8 @@ inline std::string gmsh_v22_binary(const TetMesh& m) {
   for (int i = 0; i < m.num_nodes(); ++i)
     s += bin<int>(i + 1) + bin(m.nodes[i].x()) + bin(m.nodes[i].y()) + bin(m.nodes[i].z());
   s += "\n$EndNodes\n$Elements\n" + std::to_string(m.num_tets() + 1) + "\n";
-  s += bin<int>(15) + bin<int>(1) + bin<int>(2) + bin<int>(1) + bin<int>(0) + bin<int>(0) + bin<int>(1);
+  s += bin<int>(15) + bin<int>(1) + bin<int>(2) + bin<int>(1) + bin<int>(0) + bin<int>(0) +
+       bin<int>(1);
   s += bin<int>(4) + bin<int>(m.num_tets()) + bin<int>(2);
   for (int t = 0; t < m.num_tets(); ++t) {
     s += bin<int>(t + 2) + bin<int>(0) + bin<int>(0);
@@ -166,8 +170,8 @@ inline std::string gmsh_v41_binary(const TetMesh& m) {
 inline std::pair<std::string, std::string> tetgen_files(const TetMesh& m, int base) {
   std::string node = "# generated\n" + std::to_string(m.num_nodes()) + " 3 1 1\n";
   for (int i = 0; i < m.num_nodes(); ++i)
-    node += std::to_string(base + i) + " " + fmt(m.nodes[i].x()) + " " + fmt(m.nodes[i].y()) +
-            " " + fmt(m.nodes[i].z()) + " 0.0 1  # node\n";
+    node += std::to_string(base + i) + " " + fmt(m.nodes[i].x()) + " " + fmt(m.nodes[i].y()) + " " +
+            fmt(m.nodes[i].z()) + " 0.0 1  # node\n";
   std::string ele = std::to_string(m.num_tets()) + " 4 1\n";
   for (int t = 0; t < m.num_tets(); ++t) {
     ele += std::to_string(base + t);
@@ -185,16 +189,21 @@ inline std::string vtk_ascii(const TetMesh& m, bool v51 = false) {
   const int nt = m.num_tets();
   if (v51) {
     // one extra vertex cell (type 1) to be ignored
-    s += "CELLS " + std::to_string(nt + 2) + " " + std::to_string(4 * nt + 1) + "\nOFFSETS vtktypeint64\n";
+    s += "CELLS " + std::to_string(nt + 2) + " " + std::to_string(4 * nt + 1) +
+         "\nOFFSETS vtktypeint64\n";
     for (int t = 0; t <= nt; ++t) s += std::to_string(4 * t) + " ";
     s += std::to_string(4 * nt + 1) + "\nCONNECTIVITY vtktypeint64\n";
-    for (const Tet& t : m.tets) s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " + std::to_string(t[3]) + "\n";
+    for (const Tet& t : m.tets)
+      s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " +
+           std::to_string(t[3]) + "\n";
     s += "0\nCELL_TYPES " + std::to_string(nt + 1) + "\n";
     for (int t = 0; t < nt; ++t) s += "10\n";
     s += "1\n";
   } else {
     s += "CELLS " + std::to_string(nt + 1) + " " + std::to_string(5 * nt + 2) + "\n";
-    for (const Tet& t : m.tets) s += "4 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " + std::to_string(t[3]) + "\n";
+    for (const Tet& t : m.tets)
+      s += "4 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) +
+           " " + std::to_string(t[3]) + "\n";
     s += "1 0\nCELL_TYPES " + std::to_string(nt + 1) + "\n";
     for (int t = 0; t < nt; ++t) s += "10\n";
     s += "1\n";
@@ -221,17 +230,25 @@ inline std::string vtk_binary(const TetMesh& m, bool use_float) {
 
 inline std::string vtu_ascii(const TetMesh& m) {
   const int nt = m.num_tets();
-  std::string s = "<?xml version=\"1.0\"?>\n<!-- test file -->\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
-  s += "<Piece NumberOfPoints=\"" + std::to_string(m.num_nodes()) + "\" NumberOfCells='" + std::to_string(nt + 1) + "'>\n";
+  std::string s =
+      "<?xml version=\"1.0\"?>\n<!-- test file -->\n<VTKFile type=\"UnstructuredGrid\" "
+      "version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+  s += "<Piece NumberOfPoints=\"" + std::to_string(m.num_nodes()) + "\" NumberOfCells='" +
+       std::to_string(nt + 1) + "'>\n";
   s += "<PointData Scalars=\"s\"><DataArray type=\"Float64\" Name=\"s\" format=\"ascii\">";
   for (int i = 0; i < m.num_nodes(); ++i) s += "0 ";
-  s += "</DataArray></PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  s += "</DataArray></PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+       "format=\"ascii\">\n";
   for (const Vec3& x : m.nodes) s += fmt(x.x()) + " " + fmt(x.y()) + " " + fmt(x.z()) + "\n";
-  s += "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const Tet& t : m.tets) s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " + std::to_string(t[3]) + "\n";
+  s += "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
+       "format=\"ascii\">\n";
+  for (const Tet& t : m.tets)
+    s += std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + " " +
+         std::to_string(t[3]) + "\n";
   s += "0 1 2\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
   for (int t = 1; t <= nt; ++t) s += std::to_string(4 * t) + "\n";
-  s += std::to_string(4 * nt + 3) + "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  s += std::to_string(4 * nt + 3) +
+       "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
   for (int t = 0; t < nt; ++t) s += "10\n";
   s += "5\n</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   return s;
@@ -250,10 +267,12 @@ inline std::string obj_surface(const TetMesh& m) {
 
 inline std::string off_surface(const TetMesh& m) {
   const BoundarySurface b = extract_boundary_surface(m);
-  std::string s = "OFF\n" + std::to_string(m.num_nodes()) + " " + std::to_string(b.triangles.size()) + " 0\n";
+  std::string s =
+      "OFF\n" + std::to_string(m.num_nodes()) + " " + std::to_string(b.triangles.size()) + " 0\n";
   for (const Vec3& x : m.nodes) s += fmt(x.x()) + " " + fmt(x.y()) + " " + fmt(x.z()) + "\n";
   for (const auto& t : b.triangles)
-    s += "3 " + std::to_string(t.nodes[0]) + " " + std::to_string(t.nodes[1]) + " " + std::to_string(t.nodes[2]) + "\n";
+    s += "3 " + std::to_string(t.nodes[0]) + " " + std::to_string(t.nodes[1]) + " " +
+         std::to_string(t.nodes[2]) + "\n";
   return s;
 }
 
@@ -262,7 +281,9 @@ inline std::string stl_ascii(const TetMesh& m) {
   std::string s = "solid box\n";
   for (const auto& t : b.triangles) {
     s += " facet normal 0 0 0\n  outer loop\n";
-    for (int v : t.nodes) s += "   vertex " + fmt(m.nodes[v].x()) + " " + fmt(m.nodes[v].y()) + " " + fmt(m.nodes[v].z()) + "\n";
+    for (int v : t.nodes)
+      s += "   vertex " + fmt(m.nodes[v].x()) + " " + fmt(m.nodes[v].y()) + " " +
+           fmt(m.nodes[v].z()) + "\n";
     s += "  endloop\n endfacet\n";
   }
   return s + "endsolid box\n";

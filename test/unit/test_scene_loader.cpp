@@ -86,10 +86,10 @@ TEST(SceneLoader, QuaternionIsNormalizedAndFlippedMeshWarns) {
   TetMesh box = test::small_box();
   for (Tet& t : box.tets) std::swap(t[1], t[2]);
   write_file(dir.file("box.msh"), test::gmsh_v1(box));
-  const std::string path = write_file(
-      dir.file("s.yaml"),
-      "mesh: {file: box.msh}\nfixed: [{nodes: [0]}]\n"
-      "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 2, 0]}\n");
+  const std::string path =
+      write_file(dir.file("s.yaml"),
+                 "mesh: {file: box.msh}\nfixed: [{nodes: [0]}]\n"
+                 "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 2, 0]}\n");
   const Scene s = load_scene(path);
   EXPECT_NEAR(s.trajectory[0].orientation.norm(), 1.0, 1e-15);
   EXPECT_NEAR(s.trajectory[0].orientation.z(), 1.0, 1e-15);
@@ -119,8 +119,8 @@ TEST_P(RefusesBadScenes, NamesFileKeyAndLine) {
   std::string open = test::obj_surface(test::small_box());  // minus its last triangle
   open.erase(open.rfind("f "));
   write_file(dir.file("open.obj"), open);
-  const std::string path =
-      write_file(dir.file("scene.yaml"), c.whole ? std::string(c.yaml) : kHeader + std::string(c.yaml));
+  const std::string path = write_file(
+      dir.file("scene.yaml"), c.whole ? std::string(c.yaml) : kHeader + std::string(c.yaml));
   try {
     load_scene(path);
     FAIL() << "loaded";
@@ -128,7 +128,8 @@ TEST_P(RefusesBadScenes, NamesFileKeyAndLine) {
     const std::string msg = e.what();
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
     EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
-    const std::string key = c.line > 0 ? ":" + std::to_string(c.line) + ": " + c.key : std::string(": ") + c.key;
+    const std::string key =
+        c.line > 0 ? ":" + std::to_string(c.line) + ": " + c.key : std::string(": ") + c.key;
     EXPECT_NE(msg.find(key), std::string::npos) << msg << "\n  expected: " << key;
     EXPECT_NE(msg.find(c.problem), std::string::npos) << msg << "\n  expected: " << c.problem;
   }
@@ -138,59 +139,126 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, RefusesBadScenes,
     ::testing::Values(
         SceneErrorCase{"unknown_top_key", "colour: red\n", "colour", 3, "unknown key"},
-        SceneErrorCase{"unknown_nested_key", "material: {young_modulus: 1, stiffness: 2}\n", "material.stiffness", 3, "unknown key"},
-        SceneErrorCase{"duplicate_key", "gravity: [0, 0, 0]\ngravity: [0, 0, 1]\n", "gravity", 4, "duplicate"},
+        SceneErrorCase{"unknown_nested_key", "material: {young_modulus: 1, stiffness: 2}\n",
+                       "material.stiffness", 3, "unknown key"},
+        SceneErrorCase{"duplicate_key", "gravity: [0, 0, 0]\ngravity: [0, 0, 1]\n", "gravity", 4,
+                       "duplicate"},
         SceneErrorCase{"yaml_syntax", "material: {young_modulus: [1\n", "YAML syntax error", 0, ""},
         SceneErrorCase{"empty_file", "", "scene file is empty", 0, "", true},
         SceneErrorCase{"top_not_map", "- 1\n- 2\n", "expected a map", 0, "", true},
         SceneErrorCase{"missing_mesh", "fixed: [{nodes: [0]}]\n", "mesh", 1, "missing", true},
-        SceneErrorCase{"mesh_file_and_generator", "mesh: {file: box.msh, generator: {type: box}}\nfixed: [{nodes: [0]}]\n", "mesh", 1, "exactly one", true},
-        SceneErrorCase{"missing_mesh_file", "mesh: {file: nothere.msh}\nfixed: [{nodes: [0]}]\n", "mesh.file", 1, "no such file", true},
-        SceneErrorCase{"open_surface", "mesh: {file: open.obj}\nfixed: [{nodes: [0]}]\n", "mesh.file", 1, "not closed", true},
-        SceneErrorCase{"tetgen_on_msh", "mesh: {file: box.msh, tetgen: {switches: pq}}\nfixed: [{nodes: [0]}]\n", "mesh.tetgen", 1, "only applies", true},
-        SceneErrorCase{"bad_generator_type", "mesh: {generator: {type: sphere}}\nfixed: [{nodes: [0]}]\n", "mesh.generator.type", 1, "unknown generator", true},
-        SceneErrorCase{"box_generator_thigh_key", "mesh: {generator: {type: box, inner_radius: 1}}\nfixed: [{nodes: [0]}]\n", "mesh.generator.inner_radius", 1, "unknown key", true},
-        SceneErrorCase{"box_cells_zero", "mesh: {generator: {type: box, cells: [1, 0, 1]}}\nfixed: [{nodes: [0]}]\n", "mesh.generator.cells[1]", 1, "out of range", true},
-        SceneErrorCase{"box_too_many_cells", "mesh: {generator: {type: box, cells: [1000, 1000, 1000]}}\nfixed: [{nodes: [0]}]\n", "mesh.generator.cells", 1, "too many", true},
-        SceneErrorCase{"thigh_radii", "mesh: {generator: {type: thigh, inner_radius: 0.1, outer_radius: 0.05}}\nfixed: [{nodes: [0]}]\n", "mesh.generator", 1, "outer_radius", true},
-        SceneErrorCase{"scale_zero", "mesh: {file: box.msh, scale: 0}\nfixed: [{nodes: [0]}]\n", "mesh.scale", 1, "> 0", true},
-        SceneErrorCase{"scale_string", "mesh: {file: box.msh, scale: big}\nfixed: [{nodes: [0]}]\n", "mesh.scale", 1, "expected a number", true},
-        SceneErrorCase{"scale_quoted", "mesh: {file: box.msh, scale: \"2\"}\nfixed: [{nodes: [0]}]\n", "mesh.scale", 1, "expected a number", true},
-        SceneErrorCase{"scale_overflow", "mesh: {file: box.msh, scale: 1e308}\nfixed: [{nodes: [0]}]\n", "mesh.scale", 1, "non-finite", true},
-        SceneErrorCase{"young_zero", "material: {young_modulus: 0}\n", "material.young_modulus", 3, "> 0"},
-        SceneErrorCase{"young_nan", "material: {young_modulus: .nan}\n", "material.young_modulus", 3, "finite"},
-        SceneErrorCase{"young_inf", "material:\n  young_modulus: .inf\n", "material.young_modulus", 4, "finite"},
-        SceneErrorCase{"nu_half", "material: {poisson_ratio: 0.5}\n", "material.poisson_ratio", 3, "(-1, 0.5)"},
-        SceneErrorCase{"nu_minus_one", "material: {poisson_ratio: -1}\n", "material.poisson_ratio", 3, "(-1, 0.5)"},
-        SceneErrorCase{"density_negative", "material: {density: -1}\n", "material.density", 3, ">= 0"},
+        SceneErrorCase{"mesh_file_and_generator",
+                       "mesh: {file: box.msh, generator: {type: box}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh", 1, "exactly one", true},
+        SceneErrorCase{"missing_mesh_file", "mesh: {file: nothere.msh}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.file", 1, "no such file", true},
+        SceneErrorCase{"open_surface", "mesh: {file: open.obj}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.file", 1, "not closed", true},
+        SceneErrorCase{"tetgen_on_msh",
+                       "mesh: {file: box.msh, tetgen: {switches: pq}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.tetgen", 1, "only applies", true},
+        SceneErrorCase{"bad_generator_type",
+                       "mesh: {generator: {type: sphere}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.generator.type", 1, "unknown generator", true},
+        SceneErrorCase{"box_generator_thigh_key",
+                       "mesh: {generator: {type: box, inner_radius: 1}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.generator.inner_radius", 1, "unknown key", true},
+        SceneErrorCase{"box_cells_zero",
+                       "mesh: {generator: {type: box, cells: [1, 0, 1]}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.generator.cells[1]", 1, "out of range", true},
+        SceneErrorCase{
+            "box_too_many_cells",
+            "mesh: {generator: {type: box, cells: [1000, 1000, 1000]}}\nfixed: [{nodes: [0]}]\n",
+            "mesh.generator.cells", 1, "too many", true},
+        SceneErrorCase{"thigh_radii",
+                       "mesh: {generator: {type: thigh, inner_radius: 0.1, outer_radius: "
+                       "0.05}}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.generator", 1, "outer_radius", true},
+        SceneErrorCase{"scale_zero", "mesh: {file: box.msh, scale: 0}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.scale", 1, "> 0", true},
+        SceneErrorCase{"scale_string", "mesh: {file: box.msh, scale: big}\nfixed: [{nodes: [0]}]\n",
+                       "mesh.scale", 1, "expected a number", true},
+        SceneErrorCase{"scale_quoted",
+                       "mesh: {file: box.msh, scale: \"2\"}\nfixed: [{nodes: [0]}]\n", "mesh.scale",
+                       1, "expected a number", true},
+        SceneErrorCase{"scale_overflow",
+                       "mesh: {file: box.msh, scale: 1e308}\nfixed: [{nodes: [0]}]\n", "mesh.scale",
+                       1, "non-finite", true},
+        SceneErrorCase{"young_zero", "material: {young_modulus: 0}\n", "material.young_modulus", 3,
+                       "> 0"},
+        SceneErrorCase{"young_nan", "material: {young_modulus: .nan}\n", "material.young_modulus",
+                       3, "finite"},
+        SceneErrorCase{"young_inf", "material:\n  young_modulus: .inf\n", "material.young_modulus",
+                       4, "finite"},
+        SceneErrorCase{"nu_half", "material: {poisson_ratio: 0.5}\n", "material.poisson_ratio", 3,
+                       "(-1, 0.5)"},
+        SceneErrorCase{"nu_minus_one", "material: {poisson_ratio: -1}\n", "material.poisson_ratio",
+                       3, "(-1, 0.5)"},
+        SceneErrorCase{"density_negative", "material: {density: -1}\n", "material.density", 3,
+                       ">= 0"},
         SceneErrorCase{"no_fixed", "mesh: {file: box.msh}\n", "fixed", 1, "floats", true},
-        SceneErrorCase{"fixed_empty", "mesh: {file: box.msh}\nfixed: []\n", "fixed", 2, "floats", true},
-        SceneErrorCase{"fixed_not_list", "mesh: {file: box.msh}\nfixed: {nodes: [0]}\n", "fixed", 2, "list", true},
-        SceneErrorCase{"node_out_of_range", "mesh: {file: box.msh}\nfixed: [{nodes: [0, 18]}]\n", "fixed[0].nodes[1]", 2, "out of range", true},
-        SceneErrorCase{"node_negative", "mesh: {file: box.msh}\nfixed: [{nodes: [-1]}]\n", "fixed[0].nodes[0]", 2, "out of range", true},
-        SceneErrorCase{"node_not_int", "mesh: {file: box.msh}\nfixed: [{nodes: [1.5]}]\n", "fixed[0].nodes[0]", 2, "integer", true},
-        SceneErrorCase{"selector_two_kinds", "mesh: {file: box.msh}\nfixed: [{nodes: [0], sphere: {center: [0,0,0], radius: 1}}]\n", "fixed[0]", 2, "exactly one", true},
-        SceneErrorCase{"selector_matches_nothing", "mesh: {file: box.msh}\nfixed:\n  - {box: {min: [5, 5, 5], max: [6, 6, 6]}}\n", "fixed[0]", 3, "selects no node", true},
-        SceneErrorCase{"box_min_gt_max", "mesh: {file: box.msh}\nfixed: [{box: {min: [1, 0, 0], max: [0, 1, 1]}}]\n", "fixed[0].box", 2, "min must be <= max", true},
+        SceneErrorCase{"fixed_empty", "mesh: {file: box.msh}\nfixed: []\n", "fixed", 2, "floats",
+                       true},
+        SceneErrorCase{"fixed_not_list", "mesh: {file: box.msh}\nfixed: {nodes: [0]}\n", "fixed", 2,
+                       "list", true},
+        SceneErrorCase{"node_out_of_range", "mesh: {file: box.msh}\nfixed: [{nodes: [0, 18]}]\n",
+                       "fixed[0].nodes[1]", 2, "out of range", true},
+        SceneErrorCase{"node_negative", "mesh: {file: box.msh}\nfixed: [{nodes: [-1]}]\n",
+                       "fixed[0].nodes[0]", 2, "out of range", true},
+        SceneErrorCase{"node_not_int", "mesh: {file: box.msh}\nfixed: [{nodes: [1.5]}]\n",
+                       "fixed[0].nodes[0]", 2, "integer", true},
+        SceneErrorCase{
+            "selector_two_kinds",
+            "mesh: {file: box.msh}\nfixed: [{nodes: [0], sphere: {center: [0,0,0], radius: 1}}]\n",
+            "fixed[0]", 2, "exactly one", true},
+        SceneErrorCase{
+            "selector_matches_nothing",
+            "mesh: {file: box.msh}\nfixed:\n  - {box: {min: [5, 5, 5], max: [6, 6, 6]}}\n",
+            "fixed[0]", 3, "selects no node", true},
+        SceneErrorCase{"box_min_gt_max",
+                       "mesh: {file: box.msh}\nfixed: [{box: {min: [1, 0, 0], max: [0, 1, 1]}}]\n",
+                       "fixed[0].box", 2, "min must be <= max", true},
         SceneErrorCase{"vector_length", "gravity: [0, 0]\n", "gravity", 3, "list of 3 numbers"},
         SceneErrorCase{"vector_nan", "gravity: [0, .NaN, 0]\n", "gravity[1]", 3, "finite"},
-        SceneErrorCase{"sphere_radius_negative", "operation_region: {sphere: {center: [1, 0.5, 0.5], radius: -1}}\n", "operation_region.sphere.radius", 3, "> 0"},
-        SceneErrorCase{"region_word", "operation_region: most\n", "operation_region", 3, "expected all, none"},
-        SceneErrorCase{"region_empty", "operation_region: {box: {min: [10, 10, 10], max: [11, 11, 11]}}\n", "operation_region", 3, "no element centroid"},
+        SceneErrorCase{"sphere_radius_negative",
+                       "operation_region: {sphere: {center: [1, 0.5, 0.5], radius: -1}}\n",
+                       "operation_region.sphere.radius", 3, "> 0"},
+        SceneErrorCase{"region_word", "operation_region: most\n", "operation_region", 3,
+                       "expected all, none"},
+        SceneErrorCase{"region_empty",
+                       "operation_region: {box: {min: [10, 10, 10], max: [11, 11, 11]}}\n",
+                       "operation_region", 3, "no element centroid"},
         SceneErrorCase{"load_no_force", "loads: [{nodes: [1]}]\n", "loads[0]", 3, "force"},
-        SceneErrorCase{"load_both_forces", "loads: [{nodes: [1], force: [0,0,1], total_force: [0,0,1]}]\n", "loads[0]", 3, "exactly one"},
-        SceneErrorCase{"load_force_length", "loads:\n  - {nodes: [1], force: [0, 1]}\n", "loads[0].force", 4, "3 numbers"},
-        SceneErrorCase{"blade_length_zero", "scalpel: {blade_length: 0}\n", "scalpel.blade_length", 3, "> 0"},
-        SceneErrorCase{"cut_pressure_negative", "scalpel: {cut_pressure: -0.1}\n", "scalpel.cut_pressure", 3, ">= 0"},
-        SceneErrorCase{"trajectory_time_order", "trajectory:\n  - {t: 0.5, position: [0, 0, 0]}\n  - {t: 0.5, position: [0, 0, 1]}\n", "trajectory[1].t", 5, "strictly increasing"},
-        SceneErrorCase{"trajectory_zero_quaternion", "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 0, 0]}\n", "trajectory[0].orientation", 4, "zero quaternion"},
-        SceneErrorCase{"trajectory_quaternion_length", "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 1]}\n", "trajectory[0].orientation", 4, "4 numbers"},
-        SceneErrorCase{"trajectory_missing_position", "trajectory:\n  - {t: 0}\n", "trajectory[0]", 4, "position"},
+        SceneErrorCase{"load_both_forces",
+                       "loads: [{nodes: [1], force: [0,0,1], total_force: [0,0,1]}]\n", "loads[0]",
+                       3, "exactly one"},
+        SceneErrorCase{"load_force_length", "loads:\n  - {nodes: [1], force: [0, 1]}\n",
+                       "loads[0].force", 4, "3 numbers"},
+        SceneErrorCase{"blade_length_zero", "scalpel: {blade_length: 0}\n", "scalpel.blade_length",
+                       3, "> 0"},
+        SceneErrorCase{"cut_pressure_negative", "scalpel: {cut_pressure: -0.1}\n",
+                       "scalpel.cut_pressure", 3, ">= 0"},
+        SceneErrorCase{
+            "trajectory_time_order",
+            "trajectory:\n  - {t: 0.5, position: [0, 0, 0]}\n  - {t: 0.5, position: [0, 0, 1]}\n",
+            "trajectory[1].t", 5, "strictly increasing"},
+        SceneErrorCase{"trajectory_zero_quaternion",
+                       "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 0, 0]}\n",
+                       "trajectory[0].orientation", 4, "zero quaternion"},
+        SceneErrorCase{"trajectory_quaternion_length",
+                       "trajectory:\n  - {t: 0, position: [0, 0, 0], orientation: [0, 0, 1]}\n",
+                       "trajectory[0].orientation", 4, "4 numbers"},
+        SceneErrorCase{"trajectory_missing_position", "trajectory:\n  - {t: 0}\n", "trajectory[0]",
+                       4, "position"},
         SceneErrorCase{"backend", "solver: {backend: cuda}\n", "solver.backend", 3, "cpu or gl"},
         SceneErrorCase{"tolerance_zero", "solver: {tolerance: 0}\n", "solver.tolerance", 3, "> 0"},
-        SceneErrorCase{"max_iterations_zero", "solver: {max_iterations: 0}\n", "solver.max_iterations", 3, "out of range"},
-        SceneErrorCase{"max_iterations_float", "solver: {max_iterations: 10.5}\n", "solver.max_iterations", 3, "integer"}),
-    [](const ::testing::TestParamInfo<SceneErrorCase>& info) { return std::string(info.param.name); });
+        SceneErrorCase{"max_iterations_zero", "solver: {max_iterations: 0}\n",
+                       "solver.max_iterations", 3, "out of range"},
+        SceneErrorCase{"max_iterations_float", "solver: {max_iterations: 10.5}\n",
+                       "solver.max_iterations", 3, "integer"}),
+    [](const ::testing::TestParamInfo<SceneErrorCase>& info) {
+      return std::string(info.param.name);
+    });
 
 TEST(SceneLoader, MissingSceneFileAndBadMeshNameTheFile) {
   try {
@@ -201,13 +269,14 @@ TEST(SceneLoader, MissingSceneFileAndBadMeshNameTheFile) {
   }
   TempDir dir;
   write_file(dir.file("bad.msh"), "$NOD\n2\n1 0 0 0\n2 0 0 nan\n$ENDNOD\n");
-  const std::string path = write_file(dir.file("s.yaml"), "mesh:\n  file: bad.msh\nfixed: [{nodes: [0]}]\n");
+  const std::string path =
+      write_file(dir.file("s.yaml"), "mesh:\n  file: bad.msh\nfixed: [{nodes: [0]}]\n");
   try {
     load_scene(path);
     FAIL();
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), path + ":2: mesh.file: " + dir.file("bad.msh") +
-                                         ":4: non-finite z coordinate 'nan'");
+    EXPECT_EQ(std::string(e.what()),
+              path + ":2: mesh.file: " + dir.file("bad.msh") + ":4: non-finite z coordinate 'nan'");
   }
 }
 
