@@ -1,5 +1,6 @@
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
+#include "soft_tissue_cutting/generators/local_refinement.hpp"
 #include "structured_tets.hpp"
 
 #include <algorithm>
@@ -62,9 +63,18 @@ Scene make_thigh_scene(double resolution) {
   scene.source = "thigh";
   GeneratorParams g;
   g.type = "thigh";
-  g.resolution = resolution;
+  // A coarse structured tube (2 x 13 x 6 cells at resolution 1) whose operation region is
+  // refined by TetGen to tets of at most 0.25 cm^3: the condensed part comes out near the
+  // paper's 633 nodes / 2134 tets, and the operation part gets the interior nodes a cut
+  // needs (only operation nodes can be duplicated; interface nodes never are).
+  g.resolution = 0.8 * resolution;
   scene.generator = g;
-  scene.mesh = make_thigh_mesh(g);
+  scene.operation_region.kind = OperationRegion::Kind::kSphere;
+  // A sphere centred on the outer wall at theta = 0, mid-length: the part the scalpel cuts.
+  const Vec3 centre(g.outer_radius, 0.0, 0.5 * g.length);
+  scene.operation_region.sphere = Sphere{centre, 0.04};
+  scene.mesh = refine_region(make_thigh_mesh(g), scene.operation_region,
+                             2.5e-7 / (resolution * resolution * resolution));
   scene.material = Material{3000.0, 0.45, 1000.0};
 
   // The bone surface (inner wall) is fixed.
@@ -75,12 +85,6 @@ Scene make_thigh_scene(double resolution) {
     if (std::hypot(x.x(), x.y()) <= g.inner_radius * (1 + 1e-9)) bone.nodes.push_back(i);
   }
   scene.fixed.push_back(bone);
-
-  // Operation region: a sphere centred on the outer wall at theta = 0, mid-length, reaching
-  // about one cell layer deep - the small part the scalpel cuts.
-  const Vec3 centre(g.outer_radius, 0.0, 0.5 * g.length);
-  scene.operation_region.kind = OperationRegion::Kind::kSphere;
-  scene.operation_region.sphere = Sphere{centre, 0.04};
 
   // Three outer-wall nodes nearest the region centre carry the paper's initial loads, pushed
   // radially inward.
@@ -100,7 +104,7 @@ Scene make_thigh_scene(double resolution) {
     scene.loads.push_back(load);
   }
 
-  scene.scalpel = ScalpelParams{0.02, 0.05};
+  scene.scalpel = ScalpelParams{0.02, 0.5};  // yields after a few mm of pressing
   // The scripted scalpel: approach the outer wall edge-first, press in, then draw the blade
   // along z through the operation region (the cut), all in the tube's frame.
   // The blade's edge runs from the tip along local +x = world +x (radially outward at

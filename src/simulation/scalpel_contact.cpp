@@ -53,22 +53,30 @@ std::optional<ContactAnchor> find_contact(const TetMesh& mesh, const Eigen::Vect
     Vec3 w;
     const Vec3 q = closest_on_triangle(tip, x[0], x[1], x[2], w);
     const double distance = (tip - q).norm();
-    // Beneath the surface: on the inner side of the triangle's outward normal.
-    if (distance > reach || distance >= best_distance || (tip - q).dot(n) > 0) continue;
-    const Vec3& r0 = mesh.nodes[t.nodes[0]];
-    const Vec3& r1 = mesh.nodes[t.nodes[1]];
-    const Vec3& r2 = mesh.nodes[t.nodes[2]];
+    // Beneath the triangle itself: the tip projects inside it (so the push is along its
+    // normal, not sideways onto a neighbour's edge) and lies on its inner side.
+    constexpr double kEdgeSlack = 1e-9;
+    const Vec3 nn = n.normalized();
+    if (distance > reach || distance >= best_distance || (tip - q).dot(nn) > 0) continue;
+    if ((tip - q).cross(nn).norm() > kEdgeSlack * (1 + distance / reach) + 1e-12 &&
+        w.minCoeff() <= 0)
+      continue;
     best_distance = distance;
-    best = ContactAnchor{t.nodes, w[0] * r0 + w[1] * r1 + w[2] * r2,
-                         (r1 - r0).cross(r2 - r0).normalized()};
+    best = ContactAnchor{t.nodes,
+                         {x[0] - mesh.nodes[t.nodes[0]], x[1] - mesh.nodes[t.nodes[1]],
+                          x[2] - mesh.nodes[t.nodes[2]]},
+                         q, n.normalized()};
   }
   return best;
 }
 
-std::optional<Vec3> anchored_displacement(const ContactAnchor& anchor, const Vec3& tip) {
-  const Vec3 d = tip - anchor.material_point;
-  if (d.dot(anchor.rest_normal) >= 0) return std::nullopt;  // withdrawn: released
-  return d;
+std::optional<std::array<Vec3, 3>> anchored_displacements(const ContactAnchor& anchor,
+                                                          const Vec3& tip) {
+  const Vec3 push = tip - anchor.touch_point;
+  if (push.dot(anchor.touch_normal) >= 0) return std::nullopt;
+  std::array<Vec3, 3> u = anchor.touch_displacement;
+  for (Vec3& ui : u) ui += push;
+  return u;
 }
 
 }  // namespace stc

@@ -187,8 +187,8 @@ struct Simulation::Impl {
           if (anchor) blade_state = BladeState::kPressing;
         }
         if (blade_state == BladeState::kPressing) {
-          if (const auto d = anchored_displacement(*anchor, tip)) {
-            for (int n : anchor->nodes) contact[n] = *d;
+          if (const auto u = anchored_displacements(*anchor, tip)) {
+            for (int k = 0; k < 3; ++k) contact[anchor->nodes[k]] = (*u)[k];
           } else {
             blade_state = BladeState::kFree;
             anchor.reset();
@@ -315,6 +315,11 @@ Eigen::VectorXd Simulation::full_displacement() {
 
 const std::map<std::string, double>& Simulation::precompute_timings_ms() const {
   return impl_->model->precompute_timings_ms();
+}
+
+const HybridModel& Simulation::model() const { return *impl_->model; }
+const std::vector<double>& Simulation::tet_size_classes() const {
+  return impl_->cut_state.origin_volume;
 }
 
 std::string Simulation::mesh_hash() const {

@@ -1,12 +1,11 @@
 // Contact between the blade tip and the surface of the operation part (METHOD 5 steps 2-3).
 //
-// Model: when the tip first enters the deformed surface of the operation part, the material
-// point it touches (a point of a surface triangle, kept in REST coordinates) is anchored to
-// the tip. While the blade presses, the three nodes of that triangle are imposed the
-// displacement that carries the anchored material point onto the tip (the triangle
-// translates with the blade), and the tissue's reaction on the blade is minus the force the
-// solve needs at those nodes. The contact ends when the tip withdraws above the anchored
-// triangle's rest plane. A pure plunge therefore presses; the blade cuts only once the
+// Model: when the tip first enters the deformed surface of the operation part, the surface
+// triangle it touches is anchored to the tip. While the blade presses, that triangle's three
+// nodes follow the tip from where they were at the touch (each node's displacement at the
+// touch plus the tip's motion since), and the tissue's reaction on the blade is minus the
+// force the solve needs at those nodes. The contact ends when the tip withdraws above the point it
+// first touched (the deformed surface at that moment), along that surface's normal. A pure plunge therefore presses; the blade cuts only once the
 // reaction exceeds `cut_pressure` (SPEC 3).
 #pragma once
 
@@ -14,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -21,8 +21,9 @@ namespace stc {
 
 struct ContactAnchor {
   Tri nodes;            // the touched surface triangle
-  Vec3 material_point;  // rest position of the touched point
-  Vec3 rest_normal;     // outward unit normal of the triangle at rest
+  std::array<Vec3, 3> touch_displacement;  // the nodes' displacements at the touch
+  Vec3 touch_point;     // where the tip met the deformed surface
+  Vec3 touch_normal;    // outward unit normal of the deformed triangle there
 };
 
 // The first contact of `tip` with the surface triangles (deformed positions x + u): the
@@ -33,8 +34,9 @@ std::optional<ContactAnchor> find_contact(const TetMesh& mesh, const Eigen::Vect
                                           const std::vector<BoundaryTriangle>& triangles,
                                           const Vec3& tip, double reach);
 
-// The imposed displacement of the anchor's nodes for the blade tip at `tip`, or nothing when
-// the tip has withdrawn above the anchored triangle's rest plane (contact released).
-std::optional<Vec3> anchored_displacement(const ContactAnchor& anchor, const Vec3& tip);
+// The imposed displacements of the anchor's nodes for the blade tip at `tip`, or nothing
+// when the tip has withdrawn above the point it first touched (contact released).
+std::optional<std::array<Vec3, 3>> anchored_displacements(const ContactAnchor& anchor,
+                                                          const Vec3& tip);
 
 }  // namespace stc

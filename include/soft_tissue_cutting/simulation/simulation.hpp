@@ -15,6 +15,8 @@
 
 namespace stc {
 
+class HybridModel;
+
 struct SimulationOptions {
   std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
 };
@@ -97,6 +99,10 @@ class Simulation {
   std::string stats_json(double total_ms);
   // Precompute stage timings of the condensation (ms), as the hybrid model measured them.
   const std::map<std::string, double>& precompute_timings_ms() const;
+  // The hybrid model behind the simulation (read-only: for tests and analysis).
+  const HybridModel& model() const;
+  // Per tet: the volume of the input tet it descends from (its size class, SPEC 6).
+  const std::vector<double>& tet_size_classes() const;
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;
 
