@@ -1,5 +1,5 @@
 // (d) Replaying a committed bag of scalpel poses (read with the rosbag C++ API, published on
-// /scalpel/pose at the recorded pace, original stamps kept): the wrench rises before the cut
+// /scalpel/pose in lockstep with the node's steps, original stamps kept): the wrench rises before the cut
 // begins, the surface gains cut faces, and two replays (with ~reset between) end in the same
 // mesh hash (latched std_msgs/String /tissue/mesh_hash). The achieved rate is printed.
 #include "test_helpers.hpp"
@@ -37,7 +37,6 @@ struct Fixture : testing::Test {
   ros::Publisher pose_pub;
   ros::Subscriber wrench_sub, stats_sub, hash_sub, markers_sub;
   std::vector<geometry_msgs::PoseStamped> poses;
-  std::vector<ros::Time> times;
   Replay* current = nullptr;
   std::string hash;
 
@@ -50,7 +49,6 @@ struct Fixture : testing::Test {
       auto p = m.instantiate<geometry_msgs::PoseStamped>();
       if (!p) continue;
       poses.push_back(*p);
-      times.push_back(m.getTime());
     }
     ASSERT_GT(poses.size(), 50u) << "no scalpel poses in " << path;
 
@@ -85,14 +83,24 @@ struct Fixture : testing::Test {
     spin_for(1.2);  // the post-reset hash arrives
     *initial_hash = hash;
     current = out;
-    const ros::WallTime start = ros::WallTime::now();
+    // Lockstep: after each pose, wait until the node has stepped on it (three ~stats stamped
+    // after the publish: the third step surely started after the pose arrived). The node's
+    // loop samples the latest pose on its own clock, so a replay at the recorded pace would
+    // feed a different pose sequence each time; in lockstep every replay feeds the bag's
+    // exact sequence (some poses held for a few steps, which sweeps nothing).
     for (size_t i = 0; i < poses.size(); ++i) {
-      const ros::WallTime due = start + ros::WallDuration((times[i] - times[0]).toSec());
-      while (ros::WallTime::now() < due) {
-        ros::spinOnce();
-        ros::WallDuration(0.001).sleep();
-      }
+      const ros::Time sent = ros::Time::now();
       pose_pub.publish(poses[i]);  // original (old) stamps: never a reason to drop
+      const size_t seen = out->stats.size();
+      ASSERT_TRUE(spin_until(
+          [&] {
+            int after = 0;
+            for (size_t k = seen; k < out->stats.size(); ++k)
+              after += out->stats[k].header.stamp > sent;
+            return after >= 3;
+          },
+          5.0))
+          << "the node stopped stepping";
     }
     spin_for(1.5);
     current = nullptr;
