@@ -20,12 +20,13 @@ TetMesh make_thigh_mesh(const GeneratorParams& p) {
   if (!(p.inner_radius > 0) || !(p.outer_radius > p.inner_radius) || !(p.length > 0) ||
       !(p.resolution > 0))
     throw std::invalid_argument("thigh generator: need 0 < inner_radius < outer_radius, length > 0, resolution > 0");
-  // Default resolution: 3 x 16 x 8 cells = 2304 tets, 576 nodes. Radii are graded
-  // geometrically so every cell is close to a cube (radial step ~ circumferential step), which
-  // keeps the Kuhn tets' dihedral angles near the cube's 45-90 degrees.
-  const int nr = scaled_count(3, p.resolution);
-  const int nt = std::max(3, scaled_count(16, p.resolution));
-  const int nz = scaled_count(8, p.resolution);
+  // Default resolution: 2 x 13 x 6 cells = 936 tets, 273 nodes; make_thigh_scene refines
+  // the operation region from there. Radii are graded geometrically so every cell is close
+  // to a cube (radial step ~ circumferential step), which keeps the Kuhn tets' dihedral
+  // angles near the cube's 45-90 degrees.
+  const int nr = scaled_count(2, p.resolution);
+  const int nt = std::max(3, scaled_count(13, p.resolution));
+  const int nz = scaled_count(6, p.resolution);
   TetMesh mesh;
   auto index = [&](int i, int j, int k) { return (k * nt + (j % nt)) * (nr + 1) + i; };
   mesh.nodes.resize(static_cast<size_t>((nr + 1) * nt * (nz + 1)));
@@ -58,23 +59,30 @@ TetMesh make_box_mesh(const GeneratorParams& p) {
   return mesh;
 }
 
+TetMesh refine_thigh_operation_region(const TetMesh& tube, const GeneratorParams& p,
+                                      const OperationRegion& region, double scale) {
+  if (region.kind == OperationRegion::Kind::kAll || region.kind == OperationRegion::Kind::kNone)
+    return tube;
+  // The coarse structured tube's operation region is refined by TetGen to tets of at most
+  // 0.25 cm^3 (at resolution 1): the condensed part comes out near the paper's 633 nodes /
+  // 2134 tets, and the operation part gets the interior nodes a cut needs (only operation
+  // nodes can be duplicated; interface nodes never are).
+  const double h = scale / p.resolution;
+  return refine_region(tube, region, 2.5e-7 * h * h * h);
+}
+
 Scene make_thigh_scene(double resolution) {
   Scene scene;
   scene.source = "thigh";
   GeneratorParams g;
   g.type = "thigh";
-  // A coarse structured tube (2 x 13 x 6 cells at resolution 1) whose operation region is
-  // refined by TetGen to tets of at most 0.25 cm^3: the condensed part comes out near the
-  // paper's 633 nodes / 2134 tets, and the operation part gets the interior nodes a cut
-  // needs (only operation nodes can be duplicated; interface nodes never are).
-  g.resolution = 0.8 * resolution;
+  g.resolution = resolution;
   scene.generator = g;
   scene.operation_region.kind = OperationRegion::Kind::kSphere;
   // A sphere centred on the outer wall at theta = 0, mid-length: the part the scalpel cuts.
   const Vec3 centre(g.outer_radius, 0.0, 0.5 * g.length);
   scene.operation_region.sphere = Sphere{centre, 0.04};
-  scene.mesh = refine_region(make_thigh_mesh(g), scene.operation_region,
-                             2.5e-7 / (resolution * resolution * resolution));
+  scene.mesh = refine_thigh_operation_region(make_thigh_mesh(g), g, scene.operation_region);
   scene.material = Material{3000.0, 0.45, 1000.0};
 
   // The bone surface (inner wall) is fixed.

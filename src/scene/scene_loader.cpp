@@ -53,6 +53,16 @@ class SceneLoader {
     if (root["loads"]) load_loads(root["loads"]);
     if (root["gravity"]) scene_.gravity = f_.vec3(root["gravity"], "gravity");
     if (root["operation_region"]) load_region(root["operation_region"]);
+    if (scene_.generator && scene_.generator->type == "thigh") {
+      // Same mesh as the built-in thigh: the operation region refined for cutting. Input
+      // nodes keep their indices, so `nodes:` selectors still name the same nodes.
+      try {
+        scene_.mesh = refine_thigh_operation_region(scene_.mesh, *scene_.generator,
+                                                    scene_.operation_region, scene_.scale);
+      } catch (const std::exception& e) {
+        f_.fail(root["operation_region"], "operation_region", e.what());
+      }
+    }
     if (root["scalpel"]) load_scalpel(root["scalpel"]);
     if (root["trajectory"]) load_trajectory(root["trajectory"]);
     if (root["solver"]) load_solver(root["solver"]);
@@ -126,10 +136,10 @@ class SceneLoader {
       if (g["resolution"]) p.resolution = f_.positive(g["resolution"], k + "resolution");
       if (!(p.outer_radius > p.inner_radius))
         f_.fail(g, "mesh.generator", "outer_radius must exceed inner_radius");
-      // Cells per direction as make_thigh_mesh counts them (3 x 16 x 8 at resolution 1).
+      // Cells per direction as make_thigh_mesh counts them (2 x 13 x 6 at resolution 1).
       const double r = p.resolution;
-      const double cells = std::max(1.0, std::round(3 * r)) * std::max(3.0, std::round(16 * r)) *
-                           std::max(1.0, std::round(8 * r));
+      const double cells = std::max(1.0, std::round(2 * r)) * std::max(3.0, std::round(13 * r)) *
+                           std::max(1.0, std::round(6 * r));
       if (cells > kMaxGeneratedCells)
         f_.fail(g["resolution"], k + "resolution", "too fine (more than 2e6 cells)");
     } else if (p.type == "box") {
