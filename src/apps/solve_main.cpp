@@ -1,7 +1,83 @@
 // ./tissue solve SCENE.yaml [--out OUT.vtk] [--stats OUT.json] [--backend cpu|gl]
-// (SPEC section 4). Placeholder until the pipeline lands.
+// The offline run of SPEC section 4: load, precompute the condensation, play the scene's
+// trajectory (pressure-triggered cuts included), solve the final equilibrium, write outputs.
+#include "soft_tissue_cutting/scene/scene_loader.hpp"
+#include "soft_tissue_cutting/simulation/simulation.hpp"
+
+#include <chrono>
 #include <cstdio>
-int main() {
-  std::fprintf(stderr, "tissue solve: not implemented yet\n");
+#include <cstring>
+#include <exception>
+#include <string>
+
+namespace {
+
+int usage(const char* why) {
+  std::fprintf(stderr,
+               "tissue solve: %s\nusage: tissue solve SCENE.yaml [--out OUT.vtk] "
+               "[--stats OUT.json] [--backend cpu|gl]\n",
+               why);
   return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string scene_path, out, stats, backend;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string& into) {
+      if (i + 1 >= argc) return false;
+      into = argv[++i];
+      return true;
+    };
+    if (arg == "--out") {
+      if (!value(out)) return usage("--out needs a path");
+    } else if (arg == "--stats") {
+      if (!value(stats)) return usage("--stats needs a path");
+    } else if (arg == "--backend") {
+      if (!value(backend)) return usage("--backend needs cpu or gl");
+      if (backend != "cpu" && backend != "gl") return usage("--backend must be cpu or gl");
+    } else if (!arg.empty() && arg[0] == '-') {
+      return usage(("unknown option " + arg).c_str());
+    } else if (scene_path.empty()) {
+      scene_path = arg;
+    } else {
+      return usage(("unexpected argument " + arg).c_str());
+    }
+  }
+  if (scene_path.empty()) return usage("missing SCENE.yaml");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    stc::SimulationOptions options;
+    options.backend = backend;
+    stc::Simulation sim(stc::load_scene(scene_path), options);
+    if (!sim.backend_note().empty()) std::fprintf(stderr, "tissue solve: %s\n", sim.backend_note().c_str());
+    // Step at the trajectory's poses (the scene's times), then once more without the
+    // scalpel: the final static equilibrium.
+    for (const stc::BladePose& pose : sim.scene().trajectory) {
+      const stc::StepStats s = sim.step(pose);
+      if (s.reached_interface)
+        std::fprintf(stderr, "tissue solve: t=%.3f: the blade reached the interface of the "
+                     "condensed part; cutting stops there\n", pose.t);
+    }
+    const stc::StepStats final_step = sim.step(std::nullopt);
+    if (!final_step.converged)
+      std::fprintf(stderr, "tissue solve: warning: CG did not converge (relative residual %.3g)\n",
+                   final_step.residual);
+    const double total_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!out.empty()) sim.write_vtk(out);
+    if (!stats.empty()) sim.write_stats_json(stats, total_ms);
+    const stc::ModelCounts c = sim.counts();
+    std::printf("solved %s: %d nodes, %d tets, %d cuts, %d CG iterations, residual %.3g, "
+                "backend %s, %.1f ms\n",
+                scene_path.c_str(), c.nodes, c.tets, c.cuts, final_step.cg_iterations,
+                final_step.residual, sim.backend().c_str(), total_ms);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tissue solve: %s\n", e.what());
+    return 1;
+  }
 }

@@ -1,0 +1,198 @@
+// `./tissue solve` (SPEC section 4) run as a user runs it: the tissue_solve executable on
+// scene files, its VTK and JSON outputs parsed and checked against the contract and against
+// the full uncondensed model.
+#include "soft_tissue_cutting/assembly/full_model.hpp"
+#include "soft_tissue_cutting/scene/scene_loader.hpp"
+#include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#ifndef TISSUE_SOLVE_BIN
+#error "TISSUE_SOLVE_BIN must name the tissue_solve executable (CMake defines it)"
+#endif
+
+namespace stc {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SolveRun {
+  int exit_code;
+  std::string err;
+};
+
+SolveRun run_solve(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / "tissue_solve_stderr.txt";
+  const std::string cmd = std::string(TISSUE_SOLVE_BIN) + " " + args + " 2>" + err.string() + " >/dev/null";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+}
+
+struct Vtk {
+  std::vector<Vec3> points, displacement;
+  std::vector<Tet> cells;
+  std::vector<int> region;
+};
+
+Vtk read_output(const fs::path& path) {
+  std::ifstream in(path);
+  Vtk v;
+  std::string word;
+  while (in >> word) {
+    if (word == "POINTS") {
+      int n;
+      in >> n >> word;
+      v.points.resize(n);
+      for (auto& p : v.points) in >> p.x() >> p.y() >> p.z();
+    } else if (word == "CELLS") {
+      int n, size;
+      in >> n >> size;
+      v.cells.resize(n);
+      for (auto& c : v.cells) {
+        int k;
+        in >> k >> c[0] >> c[1] >> c[2] >> c[3];
+        EXPECT_EQ(k, 4);
+      }
+    } else if (word == "CELL_TYPES") {
+      int n;
+      in >> n;
+      for (int i = 0, t; i < n; ++i) {
+        in >> t;
+        EXPECT_EQ(t, 10);
+      }
+    } else if (word == "VECTORS") {
+      in >> word >> word;
+      EXPECT_EQ(word, "double");
+      v.displacement.resize(v.points.size());
+      for (auto& d : v.displacement) in >> d.x() >> d.y() >> d.z();
+    } else if (word == "LOOKUP_TABLE" && !v.cells.empty() && v.region.empty()) {
+      in >> word;
+      v.region.resize(v.cells.size());
+      for (int& r : v.region) in >> r;
+    }
+  }
+  return v;
+}
+
+const std::string kScenes = std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/";
+
+TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
+  const fs::path dir = fs::temp_directory_path() / "tissue_solve_liver";
+  fs::create_directories(dir);
+  const std::string scene_file = kScenes + "liver.yaml";
+  const SolveRun r = run_solve(scene_file + " --out " + (dir / "o.vtk").string() + " --stats " +
+                          (dir / "o.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Vtk v = read_output(dir / "o.vtk");
+  const Scene scene = load_scene(scene_file);
+  ASSERT_EQ(v.points.size(), scene.mesh.nodes.size());
+  ASSERT_EQ(v.cells.size(), scene.mesh.tets.size());
+  for (size_t i = 0; i < v.points.size(); ++i) ASSERT_EQ(v.points[i], scene.mesh.nodes[i]);  // %.17g
+  int operation = 0;
+  for (int x : v.region) operation += x;
+  EXPECT_GT(operation, 0);
+  EXPECT_LT(operation, static_cast<int>(v.region.size()));
+  // Every node, interior condensed ones included, equals the full model's solution.
+  const FullModel full = assemble_full_model(scene);
+  const Vector u = SparseCholesky(full.K).solve(full.f);
+  double err = 0, ref = 0;
+  for (int row = 0; row < full.dofs.rows(); ++row) {
+    const int g = full.dofs.global_of[static_cast<size_t>(row)];
+    err = std::max(err, std::abs(v.displacement[g / 3][g % 3] - u[row]));
+    ref = std::max(ref, std::abs(u[row]));
+  }
+  std::printf("liver via tissue_solve: max |u| %.4e m, max error vs full model %.2e relative\n",
+              ref, err / ref);
+  EXPECT_LT(err / ref, 1e-9);
+
+  std::ifstream js(dir / "o.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  for (const char* key : {"nodes", "tets", "dof_operation", "nodes_interface",
+                          "nodes_surface_condensed", "nodes_interior_condensed", "cuts",
+                          "tets_split", "volume_initial", "volume_final", "cg_iterations",
+                          "residual", "backend", "timings_ms"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["nodes"], scene.mesh.num_nodes());
+  EXPECT_EQ(j["tets"], scene.mesh.num_tets());
+  EXPECT_EQ(j["backend"], "cpu");
+  EXPECT_EQ(j["cuts"], 0);
+  EXPECT_GT(j["nodes_interface"].get<int>(), 0);
+  EXPECT_LE(j["residual"].get<double>(), 1e-10);
+}
+
+TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
+  const fs::path dir = fs::temp_directory_path() / "tissue_solve_thigh";
+  fs::create_directories(dir);
+  const SolveRun r = run_solve("thigh --out " + (dir / "o.vtk").string() + " --stats " +
+                          (dir / "o.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream js(dir / "o.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  EXPECT_GT(j["cuts"].get<int>(), 0);
+  EXPECT_GT(j["tets_split"].get<int>(), 0);
+  EXPECT_NEAR(j["volume_final"].get<double>(), j["volume_initial"].get<double>(),
+              1e-9 * j["volume_initial"].get<double>());
+  const Vtk v = read_output(dir / "o.vtk");
+  EXPECT_EQ(static_cast<int>(v.points.size()), j["nodes"].get<int>());
+  EXPECT_EQ(static_cast<int>(v.cells.size()), j["tets"].get<int>());
+  for (const Vec3& d : v.displacement) ASSERT_TRUE(d.allFinite());
+  // Cells positively oriented (SPEC 4).
+  for (const Tet& c : v.cells)
+    ASSERT_GT((v.points[c[1]] - v.points[c[0]])
+                  .dot((v.points[c[2]] - v.points[c[0]]).cross(v.points[c[3]] - v.points[c[0]])),
+              0);
+}
+
+TEST(SolveCli, GlBackendAgreesWithCpu) {
+  const fs::path dir = fs::temp_directory_path() / "tissue_solve_gl";
+  fs::create_directories(dir);
+  const std::string scene_file = kScenes + "liver.yaml";
+  ASSERT_EQ(run_solve(scene_file + " --backend cpu --out " + (dir / "cpu.vtk").string()).exit_code, 0);
+  const SolveRun r = run_solve(scene_file + " --backend gl --out " + (dir / "gl.vtk").string() +
+                          " --stats " + (dir / "gl.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream js(dir / "gl.json");
+  const nlohmann::json j = nlohmann::json::parse(js);
+  ASSERT_EQ(j["backend"], "gl") << r.err;  // llvmpipe through EGL in CI
+  EXPECT_FALSE(j["renderer"].get<std::string>().empty());
+  const Vtk a = read_output(dir / "cpu.vtk"), b = read_output(dir / "gl.vtk");
+  double err = 0, ref = 0;
+  for (size_t i = 0; i < a.displacement.size(); ++i) {
+    err = std::max(err, (a.displacement[i] - b.displacement[i]).norm());
+    ref = std::max(ref, a.displacement[i].norm());
+  }
+  EXPECT_LT(err / ref, 1e-5);
+}
+
+TEST(SolveCli, BadInputIsOneLineNamingTheFile) {
+  const fs::path dir = fs::temp_directory_path() / "tissue_solve_bad";
+  fs::create_directories(dir);
+  const fs::path scene = dir / "bad.yaml";
+  std::ofstream(scene) << "mesh: {generator: {type: thigh}}\nmaterial: {young_modulus: -5}\n";
+  SolveRun r = run_solve(scene.string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("young_modulus"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  r = run_solve((dir / "missing.yaml").string());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("missing.yaml"), std::string::npos) << r.err;
+  r = run_solve(scene.string() + " --backend cuda");
+  EXPECT_NE(r.exit_code, 0);
+  r = run_solve("");
+  EXPECT_NE(r.exit_code, 0);
+}
+
+}  // namespace
+}  // namespace stc
