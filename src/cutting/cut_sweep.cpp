@@ -39,14 +39,27 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     tri.bounds(a, b);
     mark_faces_on_triangle(mesh, state, tri, a, b, options, result, new_faces);
   }
-  // The previous sweep's triangles, only where they overlap this cut's box.
-  for (const auto& tri : also_mark_in) {
-    TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
-    if (previous.degenerate()) continue;
-    Vec3 a, b;
-    previous.bounds(a, b);
-    mark_faces_on_triangle(mesh, state, previous, a.cwiseMax(lo), b.cwiseMin(hi), options, result,
-                           new_faces);
+  // Earlier triangles of the same stroke: a face that only now appears (this cut split the
+  // tets around it) may lie in any of them. Such a face belongs to a tet this cut touched,
+  // so look only inside those tets' box.
+  if (!also_mark_in.empty() && !triangles.empty()) {
+    Vec3 touched_lo = lo, touched_hi = hi;
+    for (int t : state.grid.query(mesh, lo, hi)) {
+      Vec3 a, b;
+      tet_bounds(mesh, t, a, b);
+      touched_lo = touched_lo.cwiseMin(a);
+      touched_hi = touched_hi.cwiseMax(b);
+    }
+    for (const auto& tri : also_mark_in) {
+      TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
+      if (previous.degenerate()) continue;
+      Vec3 a, b;
+      previous.bounds(a, b);
+      a = a.cwiseMax(touched_lo);
+      b = b.cwiseMin(touched_hi);
+      if ((a.array() > b.array()).any()) continue;  // no overlap
+      mark_faces_on_triangle(mesh, state, previous, a, b, options, result, new_faces);
+    }
   }
   if (!triangles.empty()) {
     // Marked faces lie inside the triangles' box; their tets overlap it.
@@ -74,7 +87,16 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
                                                   {from.tip, to.heel, to.tip}};
   const std::vector<std::array<Vec3, 3>> none;
   CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
-  state.last_sweep = sweep;
+  // The stroke so far: every non-degenerate sweep triangle since the blade began this
+  // continuous cut, so that faces spanning many small sweeps (a blade moving 1 mm per step
+  // through 6 mm tets) are still opened. Bounded so a very long stroke stays cheap.
+  constexpr size_t kMaxStrokeTriangles = 1024;
+  if (!continues) state.last_sweep.clear();
+  for (const auto& tri : sweep)
+    if ((tri[1] - tri[0]).cross(tri[2] - tri[0]).norm() > 0) state.last_sweep.push_back(tri);
+  if (state.last_sweep.size() > kMaxStrokeTriangles)
+    state.last_sweep.erase(state.last_sweep.begin(),
+                           state.last_sweep.end() - static_cast<long>(kMaxStrokeTriangles));
   state.last_sweep_end = {to.tip, to.heel};
   return result;
 }

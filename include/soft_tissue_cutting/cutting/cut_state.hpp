@@ -25,10 +25,11 @@ struct CutState {
   std::vector<std::vector<int>> node_tets;
   // Cuttable tets by rest-position box.
   TetGrid grid;
-  // The last sweep's triangles and end edge (tip, heel). A sweep that starts where the last
-  // one ended also marks faces whose centroid lies in the last sweep's triangles: faces that
-  // only appear when this sweep splits the tets straddling the shared edge line, and that
-  // neither sweep's own triangles would claim.
+  // The current stroke's sweep triangles (every sweep since the blade began this continuous
+  // cut, capped) and the last sweep's end edge (tip, heel). A sweep that starts where the last
+  // one ended also marks faces whose centroid lies in the stroke's earlier triangles: faces
+  // that only appear when this sweep splits the tets around them, and that this sweep's own
+  // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
   std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
 };

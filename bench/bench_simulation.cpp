@@ -1,0 +1,81 @@
+// Whole simulation steps on the built-in thigh (METHOD 5): the scripted scalpel presses and
+// then cuts. A cutting step = collision + cut insertion + re-assembly of the changed tets +
+// hybrid CG solve + surface recovery. Median and max over every cutting step of the stroke,
+// and tets added per cm of cut. (Issue 4's target: median under 5 ms on one core.)
+#include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/simulation/simulation.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+
+namespace stc {
+namespace {
+
+// The thigh trajectory at `substeps` poses per segment, as the trajectory player sends it.
+std::vector<BladePose> stroke(const Scene& scene, int substeps) {
+  std::vector<BladePose> out;
+  const auto& p = scene.trajectory;
+  for (size_t i = 0; i + 1 < p.size(); ++i)
+    for (int k = 0; k < substeps; ++k) {
+      const double s = static_cast<double>(k) / substeps;
+      BladePose b = p[i];
+      b.position = (1 - s) * p[i].position + s * p[i + 1].position;
+      out.push_back(b);
+    }
+  out.push_back(p.back());
+  return out;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+void BM_ThighStrokeSteps(benchmark::State& state) {
+  const Scene scene = make_thigh_scene();
+  const auto poses = stroke(scene, static_cast<int>(state.range(0)));
+  Simulation sim(scene);
+  std::vector<double> cutting_ms, pressing_ms;
+  double cut_length_cm = 0;
+  int tets_added = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    sim.reset();
+    const int tets0 = sim.mesh().num_tets();
+    state.ResumeTiming();
+    std::optional<BladePose> previous;
+    for (const BladePose& p : poses) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const StepStats s = sim.step(p);
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      if (s.cutting) {
+        cutting_ms.push_back(ms);
+        if (previous) cut_length_cm += 100 * (p.position - previous->position).norm();
+      } else if (s.in_contact) {
+        pressing_ms.push_back(ms);
+      }
+      previous = p;
+    }
+    state.PauseTiming();
+    tets_added += sim.mesh().num_tets() - tets0;
+    state.ResumeTiming();
+  }
+  state.counters["cut_step_median_ms"] = median(cutting_ms);
+  state.counters["cut_step_max_ms"] =
+      cutting_ms.empty() ? 0 : *std::max_element(cutting_ms.begin(), cutting_ms.end());
+  state.counters["press_step_median_ms"] = median(pressing_ms);
+  state.counters["cut_steps_per_stroke"] =
+      static_cast<double>(cutting_ms.size()) / static_cast<double>(state.iterations());
+  state.counters["tets_added_per_cm"] = cut_length_cm > 0 ? tets_added / cut_length_cm : 0;
+  state.SetLabel("thigh " + std::to_string(scene.mesh.num_tets()) + " tets, hybrid DOF " +
+                 std::to_string(sim.counts().dof_operation));
+}
+// 10 and 40 poses per trajectory segment: 2 mm and 0.5 mm of blade travel per step.
+BENCHMARK(BM_ThighStrokeSteps)->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace stc
