@@ -1,5 +1,5 @@
-// Jacobi-preconditioned projected Conjugate Gradient in double precision (METHOD.md section 5
-// step 5), the CPU backend of solve/linear_solver.hpp.
+// Preconditioned projected Conjugate Gradient in double precision (METHOD.md section 5 step 5),
+// the CPU backend of solve/linear_solver.hpp.
 //
 // Projection: constrained DOFs keep the value x has on entry. The residual and search
 // directions are zeroed on them, so CG runs on A_ff x_f = b_f - A_fc x_c exactly. The
@@ -7,22 +7,54 @@
 // (With contact but no loads, b_f is zero while the reduced right-hand side is not, so the
 // reduced norm is the meaningful denominator.) If the reduced right-hand side is zero the
 // solution is x_f = 0, returned with residual 0.
+//
+// Preconditioners z = M r (r is zero on constrained DOFs, and so is z):
+//   Jacobi:   M = P diag(A)^-1 P.
+//   Cholesky: M = P A^-1 P, A = L L^T factored by CHOLMOD in set_matrix, i.e. only when the
+//             hybrid matrix changes (construction, cuts, E changes; METHOD.md sections 3, 5).
+//             On the free DOFs M is (A^-1)_ff = S^-1 with S = A_ff - A_fc A_cc^-1 A_cf (block
+//             inverse), so the preconditioned operator is S^-1 A_ff = I + S^-1 A_fc A_cc^-1 A_cf:
+//             the identity plus rank <= #constrained DOFs. CG therefore needs at most
+//             #constrained + 1 iterations in exact arithmetic, whatever the condition of A, and
+//             none without constraints beyond the one exact step. Contact touches a few nodes.
+// A held free piece (simulation.cpp) makes A singular: its rigid modes are unanchored, though
+// every DOF of it is constrained. The piece is its own connected block of A, so A + d*diag(A)
+// with tiny d keeps (A^-1)_ff of the anchored rest to ~d*cond(A) and only perturbs the piece,
+// which P zeroes: that is the second attempt. An indefinite A (no SPD factor even shifted)
+// falls back to Jacobi for that matrix; preconditioner() reports it.
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
+#include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 namespace stc {
 namespace {
 
+// Relative diagonal shift of the second factorization attempt: far above the rounding of a
+// zero pivot (~1e-16 n), far below anything that would slow the preconditioned CG.
+constexpr double kShift = 1e-9;
+
 class CpuCgSolver final : public LinearSolver {
  public:
+  explicit CpuCgSolver(CgPreconditioner wanted) : wanted_(wanted) {}
+
   std::string backend() const override { return "cpu"; }
+  std::string preconditioner() const override { return active_; }
+  double setup_ms() const override { return setup_ms_; }
 
   void set_matrix(const SparseMatrix& a) override {
+    const auto t0 = std::chrono::steady_clock::now();
     a_ = a;
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
+    chol_.reset();
+    active_ = "jacobi";
+    if (wanted_ == CgPreconditioner::kCholesky) factor();
+    setup_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
 
   CgResult solve(const Vector& b, Vector& x, const std::vector<std::uint8_t>& constrained,
@@ -44,6 +76,10 @@ class CpuCgSolver final : public LinearSolver {
       return result;
     }
     const Vector m = inv_diag_.cwiseProduct(free_mask);  // projected Jacobi preconditioner
+    const auto precondition = [&](const Vector& r) -> Vector {
+      if (chol_) return chol_->solve(r).cwiseProduct(free_mask);
+      return m.cwiseProduct(r);
+    };
 
     // Restart from the true residual if the recursive one converged but the true one did not
     // (loss of orthogonality at very tight tolerances).
@@ -55,11 +91,11 @@ class CpuCgSolver final : public LinearSolver {
         return result;
       }
       if (result.iterations >= settings.max_iterations) return result;
-      Vector z = m.cwiseProduct(r);
+      Vector z = precondition(r);
       Vector p = z;
       double rz = r.dot(z);
       Vector q(n);
-      while (result.iterations < settings.max_iterations) {
+      while (result.iterations < settings.max_iterations && rz > 0) {
         q.noalias() = a_ * p;
         const double pq = p.dot(q);
         if (!(pq > 0)) break;  // not SPD on the free DOFs (or breakdown): stop, report
@@ -68,7 +104,7 @@ class CpuCgSolver final : public LinearSolver {
         r.noalias() -= alpha * q.cwiseProduct(free_mask);
         ++result.iterations;
         if (r.norm() / rhs_norm <= settings.tolerance) break;
-        z = m.cwiseProduct(r);
+        z = precondition(r);
         const double rz_new = r.dot(z);
         p = z + (rz_new / rz) * p;
         rz = rz_new;
@@ -87,12 +123,45 @@ class CpuCgSolver final : public LinearSolver {
   }
 
  private:
+  // A itself, else A + kShift diag(A) (held free piece), else Jacobi stays active.
+  void factor() {
+    if (a_.rows() == 0) return;
+    try {
+      chol_ = std::make_unique<SparseCholesky>(a_);
+      active_ = "cholesky";
+      return;
+    } catch (const std::runtime_error&) {
+    }
+    SparseMatrix shifted = a_;
+    const double dmax = a_.diagonal().cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < shifted.rows(); ++i) {
+      const double d = a_.coeff(i, i);
+      shifted.coeffRef(i, i) += kShift * (d > 0 ? d : dmax);
+    }
+    try {
+      chol_ = std::make_unique<SparseCholesky>(shifted);
+      active_ = "cholesky (shifted)";
+    } catch (const std::runtime_error&) {
+      chol_.reset();
+    }
+  }
+
+  CgPreconditioner wanted_;
   SparseMatrix a_;
   Vector inv_diag_;
+  std::unique_ptr<SparseCholesky> chol_;
+  std::string active_ = "jacobi";
+  double setup_ms_ = 0;
 };
 
 }  // namespace
 
-std::unique_ptr<LinearSolver> make_cpu_solver() { return std::make_unique<CpuCgSolver>(); }
+std::unique_ptr<LinearSolver> make_cpu_solver(CgPreconditioner preconditioner) {
+  return std::make_unique<CpuCgSolver>(preconditioner);
+}
+
+std::unique_ptr<LinearSolver> make_cpu_solver() {
+  return make_cpu_solver(CgPreconditioner::kCholesky);
+}
 
 }  // namespace stc

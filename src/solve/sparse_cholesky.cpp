@@ -21,6 +21,9 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a)
     : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
   if (rows_ == 0) return;
   const Eigen::SparseMatrix<double, Eigen::ColMajor, int> col(a);
+  // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
+  // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
+  impl_->llt.cholmod().print = 0;
   impl_->llt.compute(col);
   if (impl_->llt.info() != Eigen::Success)
     throw std::runtime_error(

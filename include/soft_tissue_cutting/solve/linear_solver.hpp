@@ -36,13 +36,29 @@ class LinearSolver {
   virtual ~LinearSolver() = default;
   virtual std::string backend() const = 0;          // "cpu" or "gl"
   virtual std::string renderer() const { return ""; }  // GL renderer string for "gl"
+  // The preconditioner in use for the current matrix ("jacobi", "cholesky", ...); it may
+  // differ from the one asked for when set_matrix had to fall back. Empty if not reported.
+  virtual std::string preconditioner() const { return ""; }
+  // Wall time of the last set_matrix in ms (factorization, for the Cholesky preconditioner).
+  virtual double setup_ms() const { return 0; }
   // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.
   virtual void set_matrix(const SparseMatrix& a) = 0;
   virtual CgResult solve(const Vector& b, Vector& x, const std::vector<std::uint8_t>& constrained,
                          const CgSettings& settings) = 0;
 };
 
-// Jacobi-preconditioned CG in double precision on the CPU.
+// Preconditioners of the CPU projected CG (src/solve/cpu_cg_solver.cpp explains them).
+//   kJacobi:   M = diag(A), the paper's plain CG setting; ~150-300 iterations on the thigh.
+//   kCholesky: M = P A^-1 P with A factored once per set_matrix (CHOLMOD). The constrained DOFs
+//              are a few contact nodes, so the preconditioned operator is the identity plus a
+//              term of rank <= #constrained DOFs: CG converges in about that many iterations.
+//              If A cannot be factored even with a tiny diagonal shift (indefinite), that
+//              matrix is solved with Jacobi instead; preconditioner() says which is active.
+enum class CgPreconditioner { kJacobi, kCholesky };
+
+// Preconditioned projected CG in double precision on the CPU.
+std::unique_ptr<LinearSolver> make_cpu_solver(CgPreconditioner preconditioner);
+// The default: CgPreconditioner::kCholesky.
 std::unique_ptr<LinearSolver> make_cpu_solver();
 
 }  // namespace stc
