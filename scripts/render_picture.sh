@@ -17,6 +17,8 @@ roslaunch -p "$port" soft_tissue_cutting view_bag.launch bag:="$bag" >"${png%.pn
 launch_pid=$!
 sleep "$wait_s"
 import -window root "$png"
+# Keep rviz's 3D view only (the panels are rviz's own UI; geometry of the 1280x1024 screen).
+convert "$png" -crop 878x906+364+63 +repage "$png"
 kill -INT "$launch_pid" 2>/dev/null || true
 wait "$launch_pid" 2>/dev/null || true
 echo "picture: $png"

@@ -94,12 +94,13 @@ Scene make_thigh_scene(double resolution) {
   }
   scene.fixed.push_back(bone);
 
-  // Three outer-wall nodes nearest the region centre carry the paper's initial loads, pushed
-  // radially inward.
+  // The paper's three loaded surface nodes: outer-wall nodes near the region centre, either
+  // side of the planned incision (the y = 0.003 plane), pulled tangentially away from it
+  // like skin under tension, so the incision gapes once it is cut.
   std::vector<std::pair<double, int>> outer;
   for (int i = 0; i < scene.mesh.num_nodes(); ++i) {
     const Vec3& x = scene.mesh.nodes[i];
-    if (std::hypot(x.x(), x.y()) >= g.outer_radius * (1 - 1e-9))
+    if (std::hypot(x.x(), x.y()) >= g.outer_radius * (1 - 1e-9) && std::abs(x.y() - 0.003) > 0.004)
       outer.emplace_back((x - centre).norm(), i);
   }
   std::sort(outer.begin(), outer.end());
@@ -108,7 +109,9 @@ Scene make_thigh_scene(double resolution) {
     load.where.kind = NodeSelector::Kind::kNodes;
     load.where.nodes = {outer[k].second};
     const Vec3& x = scene.mesh.nodes[outer[k].second];
-    load.force = -0.02 * Vec3(x.x(), x.y(), 0).normalized();
+    const Vec3 radial = Vec3(x.x(), x.y(), 0).normalized();
+    const Vec3 tangent = Vec3::UnitZ().cross(radial) * (x.y() > 0.003 ? 1.0 : -1.0);
+    load.force = 0.05 * tangent;  // N
     scene.loads.push_back(load);
   }
 

@@ -29,6 +29,12 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("backend", p.backend, p.backend);
   pnh.param<double>("max_pose_jump", p.max_pose_jump, p.max_pose_jump);
   pnh.param<double>("display_rate", p.display_rate, p.display_rate);
+  pnh.param<std::string>("parent_frame", p.parent_frame, p.parent_frame);
+  if (pnh.hasParam("parent_transform") &&
+      (!pnh.getParam("parent_transform", p.parent_transform) || p.parent_transform.size() != 7))
+    throw std::runtime_error("~parent_transform must be a list of 7 numbers: x y z qx qy qz qw");
+  for (double v : p.parent_transform)
+    if (!std::isfinite(v)) throw std::runtime_error("~parent_transform has a non-finite number");
   if (!(p.rate > 0) || !std::isfinite(p.rate))
     throw std::runtime_error("~rate must be a positive number of steps per second");
   if (!(p.max_pose_jump > 0))
@@ -76,6 +82,23 @@ TissueNode::TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams param
   wrench_pub_ = pnh_.advertise<geometry_msgs::WrenchStamped>("scalpel/wrench", 10);
   stats_pub_ = pnh_.advertise<soft_tissue_cutting::SimStats>("stats", 10);
   hash_pub_ = pnh_.advertise<std_msgs::String>("mesh_hash", 1, true);
+  if (!params_.parent_frame.empty()) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = strip_slash(params_.parent_frame);
+    t.child_frame_id = params_.frame_id;
+    const auto& v = params_.parent_transform;
+    t.transform.translation.x = v[0];
+    t.transform.translation.y = v[1];
+    t.transform.translation.z = v[2];
+    const double n = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+    if (!(n > 0)) throw std::runtime_error("~parent_transform has a zero quaternion");
+    t.transform.rotation.x = v[3] / n;
+    t.transform.rotation.y = v[4] / n;
+    t.transform.rotation.z = v[5] / n;
+    t.transform.rotation.w = v[6] / n;
+    frame_broadcaster_.sendTransform(t);
+  }
 
   cut_srv_ = pnh_.advertiseService("cut", &TissueNode::on_cut, this);
   reset_srv_ = pnh_.advertiseService("reset", &TissueNode::on_reset, this);

@@ -21,6 +21,7 @@
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
@@ -30,6 +31,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace stc {
 namespace ros_io {
@@ -42,6 +44,11 @@ struct NodeParams {
   std::string backend;        // empty: the scene's solver.backend
   double max_pose_jump = 0.05;  // m
   double display_rate = 30.0;   // Hz, upper limit for ~surface / ~markers
+  // If set, the node publishes ~frame_id as a static tf child of this frame (placed by
+  // parent_transform: x y z qx qy qz qw), so the tissue sits in a robot's tf tree and rviz
+  // has its fixed frame. Empty: someone else publishes ~frame_id.
+  std::string parent_frame;
+  std::vector<double> parent_transform = {0, 0, 0, 0, 0, 0, 1};
 };
 
 // Reads the private parameters; throws std::runtime_error naming a bad one.
@@ -89,6 +96,7 @@ class TissueNode {
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
+  tf2_ros::StaticTransformBroadcaster frame_broadcaster_;
 
   ros::Subscriber pose_sub_;
   ros::Publisher surface_pub_, markers_pub_, wrench_pub_, stats_pub_, hash_pub_;
