@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
@@ -44,7 +45,9 @@ struct Simulation::Impl {
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
   CutState cut_state;
-  BoundarySurface boundary;  // of the whole current mesh, rebuilt after cuts
+  // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
+  // refit before each contact query, so a step never scans the whole surface.
+  SurfaceBvh surface_tree;
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -97,9 +100,9 @@ struct Simulation::Impl {
     steps = 0;
     cuts = tets_split = 0;
     last = StepStats{};
-    boundary = extract_boundary_surface(model->mesh());
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
+    surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
   }
 
@@ -129,7 +132,7 @@ struct Simulation::Impl {
     for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
       if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
     hold_free_pieces();
-    boundary = extract_boundary_surface(model->mesh());
+    surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
@@ -153,12 +156,25 @@ struct Simulation::Impl {
     }
   }
 
-  std::vector<BoundaryTriangle> operation_surface() const {
-    std::vector<BoundaryTriangle> out;
-    const auto& op = model->partition().operation_tet;
-    for (const BoundaryTriangle& t : boundary.triangles)
-      if (op[static_cast<size_t>(t.tet)]) out.push_back(t);
+  std::vector<Vec3> displacements() const {
+    const Vector& u = model->displacement();
+    std::vector<Vec3> out(static_cast<size_t>(model->mesh().num_nodes()));
+    for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
     return out;
+  }
+
+  // Operation-part surface triangles near the tip (candidates from the tree).
+  std::vector<BoundaryTriangle> operation_surface_near(const Vec3& tip, double reach) const {
+    std::vector<BoundaryTriangle> out;
+    for (int t : surface_tree.near_segment(tip, tip, reach))
+      if (surface_tree.is_operation(t)) out.push_back(surface_tree.surface().triangles[t]);
+    return out;
+  }
+
+  int cut_face_count() const {
+    int n = 0;
+    for (const auto& t : surface_tree.surface().triangles) n += t.cut;
+    return n;
   }
 
   StepStats step(const std::optional<BladePose>& blade) {
@@ -182,8 +198,10 @@ struct Simulation::Impl {
         }
       } else {
         if (blade_state == BladeState::kFree) {
-          anchor = find_contact(model->mesh(), model->displacement(), operation_surface(), tip,
-                                0.5 * scene.scalpel.blade_length);
+          const double reach = 0.5 * scene.scalpel.blade_length;
+          surface_tree.refit(model->mesh(), displacements());
+          anchor = find_contact(model->mesh(), model->displacement(),
+                                operation_surface_near(tip, reach), tip, reach);
           if (anchor) blade_state = BladeState::kPressing;
         }
         if (blade_state == BladeState::kPressing) {
@@ -209,7 +227,7 @@ struct Simulation::Impl {
       }
     }
     last_pose = blade;
-    ++surface_version;
+    if (s.cg_iterations > 0 || s.cutting) ++surface_version;  // the drawn surface changed
     s.step_ms = ms_since(t_step);
     last = s;
     return s;
@@ -232,17 +250,12 @@ CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
     out.message = "need at least two blade poses to sweep a cut";
     return out;
   }
-  const int faces_before = [&] {
-    int n = 0;
-    for (const auto& t : impl_->boundary.triangles) n += t.cut;
-    return n;
-  }();
+  const int faces_before = impl_->cut_face_count();
   StepStats s;
   for (size_t i = 1; i < poses.size(); ++i) impl_->cut(poses[i - 1], poses[i], s);
   s.converged = impl_->solve({}, s);
   ++impl_->surface_version;
-  int faces_after = 0;
-  for (const auto& t : impl_->boundary.triangles) faces_after += t.cut;
+  const int faces_after = impl_->cut_face_count();
   out.tets_split = s.tets_split;
   out.nodes_added = s.nodes_added;
   out.cut_faces = faces_after - faces_before;
@@ -276,7 +289,7 @@ DeformedSurface Simulation::surface() const {
     s.positions[i] = m.nodes[i] + ui;
     s.displacement[i] = ui.norm();
   }
-  s.triangles = impl_->boundary.triangles;
+  s.triangles = impl_->surface_tree.surface().triangles;
   return s;
 }
 
