@@ -260,6 +260,12 @@ void TissueNode::loop() {
       std::optional<BladePose> blade = current_blade();
       if (blade) blade->t = static_cast<double>(steps_) / params_.rate;
       const StepStats s = sim_->step(blade);
+      if (s.reached_interface)
+        ROS_WARN_THROTTLE(2.0, "the blade reached the interface of the condensed part: cutting "
+                               "stops there (the cut stays inside the operation region)");
+      if (!s.converged)
+        ROS_WARN_THROTTLE(2.0, "CG did not converge this step (relative residual %.3g)",
+                          s.residual);
       const ros::Time stamp = ros::Time::now();
       soft_tissue_cutting::SimStats stats =
           to_stats_msg(s, sim_->counts(), sim_->backend(), sim_->renderer(), rate);
