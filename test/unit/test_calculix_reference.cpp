@@ -8,6 +8,8 @@
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
+#include "liver_test_scene.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -202,37 +204,9 @@ TEST(CalculixReference, ThighGravity) {
   check_against_calculix(s, "thigh + gravity");
 }
 
-// The SOFA livers (test/data/MESHES.md). sofa_liver: SOFA's own demo supports (nodes 3 39 64,
-// 1-based), E = 3000, nu = 0.3, gravity -y. sofa_liver2: the 10% lowest-x nodes fixed.
-// Both: a 3-node point load near the top, an operation sphere around it.
+// The SOFA livers: a 3-node load near the top, an operation sphere around it.
 Scene liver_scene(const std::string& file, bool gravity) {
-  Scene s;
-  s.source = file;
-  s.mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/" + file);
-  s.material = Material{3000.0, 0.3, 1000.0};
-  Vec3 lo = s.mesh.nodes[0], hi = lo;
-  for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  NodeSelector fixed;
-  if (file == "sofa_liver.msh") {
-    fixed.nodes = {2, 38, 63};
-  } else {
-    fixed.kind = NodeSelector::Kind::kBox;
-    fixed.box = Box{lo - Vec3::Constant(1), Vec3(lo.x() + 0.1 * (hi.x() - lo.x()), hi.y() + 1, hi.z() + 1)};
-  }
-  s.fixed.push_back(fixed);
-  // Load the three nodes with the largest y.
-  std::vector<std::pair<double, int>> top;
-  for (int n = 0; n < s.mesh.num_nodes(); ++n) top.emplace_back(-s.mesh.nodes[n].y(), n);
-  std::sort(top.begin(), top.end());
-  Load load;
-  for (int k = 0; k < 3; ++k) load.where.nodes.push_back(top[k].second);
-  load.total = true;
-  load.force = Vec3(0.5, -2.0, 0.3);
-  s.loads.push_back(load);
-  if (gravity) s.gravity = Vec3(0, -9.81, 0);
-  s.operation_region.kind = OperationRegion::Kind::kSphere;
-  s.operation_region.sphere = Sphere{s.mesh.nodes[top[0].second], 0.25 * (hi - lo).maxCoeff()};
-  return s;
+  return testing_scenes::liver_scene(file, gravity, 3, 0.25);
 }
 
 TEST(CalculixReference, SofaLiver) { check_against_calculix(liver_scene("sofa_liver.msh", false), "sofa_liver"); }

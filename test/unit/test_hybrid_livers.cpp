@@ -6,6 +6,8 @@
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
+#include "liver_test_scene.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,32 +15,9 @@
 namespace stc {
 namespace {
 
-// sofa_liver: SOFA's demo supports (1-based nodes 3 39 64); sofa_liver2: lowest 10% in x.
+// One loaded node at the top, gravity, an operation sphere of 0.3 x the extent around it.
 Scene liver(const std::string& file, OperationRegion::Kind kind) {
-  Scene s;
-  s.mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/" + file);
-  s.material = Material{3000.0, 0.3, 1000.0};
-  s.gravity = Vec3(0, -9.81, 0);
-  Vec3 lo = s.mesh.nodes[0], hi = lo;
-  for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  NodeSelector fixed;
-  if (file == "sofa_liver.msh") {
-    fixed.nodes = {2, 38, 63};
-  } else {
-    fixed.kind = NodeSelector::Kind::kBox;
-    fixed.box = Box{lo - Vec3::Constant(1), Vec3(lo.x() + 0.1 * (hi.x() - lo.x()), hi.y() + 1, hi.z() + 1)};
-  }
-  s.fixed.push_back(fixed);
-  int top = 0;
-  for (int n = 0; n < s.mesh.num_nodes(); ++n)
-    if (s.mesh.nodes[n].y() > s.mesh.nodes[top].y()) top = n;
-  Load load;
-  load.where.nodes = {top};
-  load.force = Vec3(0.5, -2.0, 0.3);
-  s.loads.push_back(load);
-  s.operation_region.kind = kind;
-  s.operation_region.sphere = Sphere{s.mesh.nodes[top], 0.3 * (hi - lo).maxCoeff()};
-  return s;
+  return testing_scenes::liver_scene(file, true, 1, 0.3, kind);
 }
 
 double max_error(const Vector& u, const Vector& ref, const std::vector<int>& nodes) {
