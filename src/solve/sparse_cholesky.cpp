@@ -7,25 +7,42 @@
 namespace stc {
 
 // Eigen's wrapper drives CHOLMOD directly: cholmod_analyze + cholmod_factorize with
-// supernodal = CHOLMOD_SUPERNODAL, and cholmod_solve on a whole dense block of right-hand
-// sides at once.
+// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), and cholmod_solve on a whole
+// dense block of right-hand sides at once.
 struct SparseCholesky::Impl {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>
-      llt;
+  using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+  Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower> supernodal;
+  Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> simplicial;
+  CholeskyMethod method = CholeskyMethod::kSupernodal;
+
+  template <typename Rhs>
+  Rhs solve(const Rhs& b) const {
+    if (method == CholeskyMethod::kSimplicial) return simplicial.solve(b);
+    return supernodal.solve(b);
+  }
 };
 
 SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
 SparseCholesky::~SparseCholesky() = default;
 
-SparseCholesky::SparseCholesky(const SparseMatrix& a)
+SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method)
     : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
+  impl_->method = method;
   if (rows_ == 0) return;
-  const Eigen::SparseMatrix<double, Eigen::ColMajor, int> col(a);
+  const Impl::ColMatrix col(a);
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
-  impl_->llt.cholmod().print = 0;
-  impl_->llt.compute(col);
-  if (impl_->llt.info() != Eigen::Success)
+  Eigen::ComputationInfo info;
+  if (method == CholeskyMethod::kSimplicial) {
+    impl_->simplicial.cholmod().print = 0;
+    impl_->simplicial.compute(col);
+    info = impl_->simplicial.info();
+  } else {
+    impl_->supernodal.cholmod().print = 0;
+    impl_->supernodal.compute(col);
+    info = impl_->supernodal.info();
+  }
+  if (info != Eigen::Success)
     throw std::runtime_error(
         "sparse Cholesky (CHOLMOD): matrix not positive definite - a part of the mesh is "
         "neither fixed nor held by the interface");
@@ -33,13 +50,13 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a)
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (rows_ == 0 || b.cols() == 0) return Eigen::MatrixXd::Zero(rows_, b.cols());
-  Eigen::MatrixXd x = impl_->llt.solve(b);
+  Eigen::MatrixXd x = impl_->solve(b);
   return x;
 }
 
 Vector SparseCholesky::solve(const Vector& b) const {
   if (rows_ == 0) return Vector::Zero(0);
-  Vector x = impl_->llt.solve(b);
+  Vector x = impl_->solve(b);
   return x;
 }
 
