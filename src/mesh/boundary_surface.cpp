@@ -1,7 +1,6 @@
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 
 #include <algorithm>
-#include <map>
 #include <unordered_map>
 
 namespace stc {
@@ -21,30 +20,45 @@ struct FaceUse {
 
 BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
   // Key each face by its sorted node triple; a boundary face is used by exactly one tet.
-  std::map<std::array<int, 3>, std::vector<FaceUse>> uses;
+  // One flat array sorted by key (rather than a map) keeps this cheap enough to redo after
+  // every cut.
+  struct FaceEntry {
+    std::array<int, 3> key;
+    int tet;
+    int face;
+    bool operator<(const FaceEntry& o) const {
+      return key != o.key ? key < o.key : (tet != o.tet ? tet < o.tet : face < o.face);
+    }
+  };
+  std::vector<FaceEntry> faces;
+  faces.reserve(4 * mesh.tets.size());
   for (int t = 0; t < mesh.num_tets(); ++t) {
     for (int f = 0; f < 4; ++f) {
       std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
                                 mesh.tets[t][kTetFaces[f][2]]};
       std::sort(key.begin(), key.end());
-      uses[key].push_back({t, f});
+      faces.push_back({key, t, f});
     }
   }
+  std::sort(faces.begin(), faces.end());
   BoundarySurface surface;
-  for (const auto& [key, list] : uses) {
-    if (list.size() == 1) {
-      const Tet& tet = mesh.tets[list[0].tet];
-      const auto& lf = kTetFaces[list[0].face];
-      surface.triangles.push_back({Tri{tet[lf[0]], tet[lf[1]], tet[lf[2]]}, list[0].tet,
-                                   list[0].face, mesh.is_cut_face(list[0].tet, list[0].face)});
-    } else if (list.size() > 2) {
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    const FaceUse first{faces[i].tet, faces[i].face};
+    if (j - i == 1) {
+      const Tet& tet = mesh.tets[first.tet];
+      const auto& lf = kTetFaces[first.face];
+      surface.triangles.push_back({Tri{tet[lf[0]], tet[lf[1]], tet[lf[2]]}, first.tet,
+                                   first.face, mesh.is_cut_face(first.tet, first.face)});
+    } else if (j - i > 2) {
       ++surface.non_manifold_faces;
     } else {
       // Two users of a face must wind it in opposite directions (tets on both sides).
-      const Tet& a = mesh.tets[list[0].tet];
-      const Tet& b = mesh.tets[list[1].tet];
-      const auto& fa = kTetFaces[list[0].face];
-      const auto& fb = kTetFaces[list[1].face];
+      const Tet& a = mesh.tets[first.tet];
+      const Tet& b = mesh.tets[faces[i + 1].tet];
+      const auto& fa = kTetFaces[first.face];
+      const auto& fb = kTetFaces[faces[i + 1].face];
       const Tri ta = {a[fa[0]], a[fa[1]], a[fa[2]]};
       const Tri tb = {b[fb[0]], b[fb[1]], b[fb[2]]};
       // Same orientation iff tb is a rotation of ta.
@@ -53,6 +67,7 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
         same |= (tb[0] == ta[r] && tb[1] == ta[(r + 1) % 3] && tb[2] == ta[(r + 2) % 3]);
       if (same) ++surface.non_manifold_faces;
     }
+    i = j;
   }
   return surface;
 }

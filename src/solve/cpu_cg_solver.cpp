@@ -127,7 +127,7 @@ class CpuCgSolver final : public LinearSolver {
   void factor() {
     if (a_.rows() == 0) return;
     try {
-      chol_ = std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSimplicial);
+      chol_ = std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal);
       active_ = "cholesky";
       return;
     } catch (const std::runtime_error&) {
@@ -139,7 +139,7 @@ class CpuCgSolver final : public LinearSolver {
       shifted.coeffRef(i, i) += kShift * (d > 0 ? d : dmax);
     }
     try {
-      chol_ = std::make_unique<SparseCholesky>(shifted, CholeskyMethod::kSimplicial);
+      chol_ = std::make_unique<SparseCholesky>(shifted, CholeskyMethod::kSupernodal);
       active_ = "cholesky (shifted)";
     } catch (const std::runtime_error&) {
       chol_.reset();
