@@ -49,8 +49,12 @@ void BM_ThighStrokeSteps(benchmark::State& state) {
     sim.reset();
     const int tets0 = sim.mesh().num_tets();
     state.ResumeTiming();
+    // Cut length: the blade's travel from its first to its last cutting step (steps in
+    // between that split nothing still move the blade through the tissue).
+    double travelled_cm = 0, travelled_at_first_cut = -1, travelled_at_last_cut = 0;
     std::optional<BladePose> previous;
     for (const BladePose& p : poses) {
+      if (previous) travelled_cm += 100 * (p.position - previous->position).norm();
       const auto t0 = std::chrono::steady_clock::now();
       const StepStats s = sim.step(p);
       const double ms =
@@ -59,7 +63,8 @@ void BM_ThighStrokeSteps(benchmark::State& state) {
         cutting_ms.push_back(ms);
         cut_factor_ms.push_back(sim.model().solver().setup_ms());
         cut_iterations.push_back(s.cg_iterations);
-        if (previous) cut_length_cm += 100 * (p.position - previous->position).norm();
+        if (travelled_at_first_cut < 0) travelled_at_first_cut = travelled_cm;
+        travelled_at_last_cut = travelled_cm;
       } else if (s.in_contact) {
         pressing_ms.push_back(ms);
         press_iterations.push_back(s.cg_iterations);
@@ -67,6 +72,7 @@ void BM_ThighStrokeSteps(benchmark::State& state) {
       previous = p;
     }
     state.PauseTiming();
+    if (travelled_at_first_cut >= 0) cut_length_cm += travelled_at_last_cut - travelled_at_first_cut;
     tets_added += sim.mesh().num_tets() - tets0;
     state.ResumeTiming();
   }
