@@ -82,6 +82,7 @@ struct Simulation::Impl {
 
   void start() {
     scene = initial;
+    refuse_floating_pieces();
     model = std::make_unique<HybridModel>(scene, make_solver());
     model->set_cg_settings(CgSettings{scene.solver.tolerance, scene.solver.max_iterations});
     // Only the operation part is cut; interface nodes stay whole so K0/R stay valid.
@@ -104,6 +105,21 @@ struct Simulation::Impl {
     last.converged = solve({}, last);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
+  }
+
+  // A piece of the input with no fixed node would float: refuse it up front with its size,
+  // before any factorization fails on it.
+  void refuse_floating_pieces() const {
+    std::vector<std::uint8_t> fixed(scene.mesh.nodes.size(), 0);
+    for (const NodeSelector& selector : scene.fixed)
+      for (int n : selector.select(scene.mesh)) fixed[static_cast<size_t>(n)] = 1;
+    const std::vector<MeshPiece> floating = free_pieces(scene.mesh, fixed);
+    if (!floating.empty())
+      throw std::invalid_argument(
+          scene.source + ": the mesh has " + std::to_string(floating.size()) +
+          " piece(s) with no fixed node (the first has " +
+          std::to_string(floating[0].tets.size()) +
+          " tets): fix at least one node of every piece");
   }
 
   bool solve(const ImposedDisplacements& contact, StepStats& s) {
@@ -242,7 +258,20 @@ Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl)
 
 Simulation::~Simulation() = default;
 
-StepStats Simulation::step(const std::optional<BladePose>& blade) { return impl_->step(blade); }
+namespace {
+bool finite_pose(const BladePose& p) {
+  return p.position.allFinite() && p.orientation.coeffs().allFinite() &&
+         p.orientation.coeffs().squaredNorm() > 1e-12;
+}
+}  // namespace
+
+StepStats Simulation::step(const std::optional<BladePose>& blade) {
+  if (blade && !finite_pose(*blade))
+    throw std::invalid_argument("blade pose is not finite (NaN/Inf or a zero quaternion)");
+  std::optional<BladePose> normalized = blade;
+  if (normalized) normalized->orientation.normalize();
+  return impl_->step(normalized);
+}
 
 CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
   CutOutcome out;
@@ -250,6 +279,11 @@ CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
     out.message = "need at least two blade poses to sweep a cut";
     return out;
   }
+  for (size_t i = 0; i < poses.size(); ++i)
+    if (!finite_pose(poses[i])) {
+      out.message = "pose " + std::to_string(i) + " is not finite";
+      return out;
+    }
   const int faces_before = impl_->cut_face_count();
   StepStats s;
   for (size_t i = 1; i < poses.size(); ++i) impl_->cut(poses[i - 1], poses[i], s);

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <map>
 
 namespace stc {
@@ -151,6 +152,35 @@ TEST(SimulationPipeline, GlBackendMatchesCpuThroughCuts) {
     ASSERT_LT(relative_difference(), 1e-5) << "step " << a.step;
   }
   EXPECT_GT(gl.counts().cuts, 0);
+}
+
+TEST(SimulationPipeline, RefusesBadInput) {
+  // A second, unfixed block beside the thigh would float: refused with one line.
+  Scene scene = make_thigh_scene();
+  GeneratorParams g;
+  g.size = Vec3(0.01, 0.01, 0.01);
+  g.cells = {1, 1, 1};
+  const TetMesh block = make_box_mesh(g);
+  const int offset = scene.mesh.num_nodes();
+  for (const Vec3& x : block.nodes) scene.mesh.nodes.push_back(x + Vec3(0.2, 0, 0));
+  for (Tet t : block.tets) {
+    for (int& v : t) v += offset;
+    scene.mesh.tets.push_back(t);
+  }
+  try {
+    Simulation floating(scene);
+    FAIL() << "a floating piece was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no fixed node"), std::string::npos) << e.what();
+  }
+  // Non-finite blade poses never reach the geometry.
+  Simulation sim(make_thigh_scene());
+  BladePose nan_pose;
+  nan_pose.position.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(sim.step(nan_pose), std::invalid_argument);
+  BladePose ok;
+  EXPECT_FALSE(sim.cut_along({ok, nan_pose}).success);
+  EXPECT_EQ(sim.counts().cuts, 0);
 }
 
 TEST(SimulationPipeline, CuttingDisabledOnlyPresses) {
