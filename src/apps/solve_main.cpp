@@ -71,9 +71,9 @@ int main(int argc, char** argv) {
     if (!out.empty()) sim.write_vtk(out);
     if (!stats.empty()) sim.write_stats_json(stats, total_ms);
     const stc::ModelCounts c = sim.counts();
-    std::printf("solved %s: %d nodes, %d tets, %d cuts, %d CG iterations, residual %.3g, "
+    std::printf("solved %s: %d nodes, %d tets, %d cuts, %ld CG iterations in all, residual %.3g, "
                 "backend %s, %.1f ms\n",
-                scene_path.c_str(), c.nodes, c.tets, c.cuts, final_step.cg_iterations,
+                scene_path.c_str(), c.nodes, c.tets, c.cuts, c.cg_iterations_total,
                 final_step.residual, sim.backend().c_str(), total_ms);
     return 0;
   } catch (const std::exception& e) {

@@ -60,6 +60,7 @@ struct Simulation::Impl {
   bool cutting_enabled = true;
   std::uint64_t steps = 0, surface_version = 0;
   int cuts = 0, tets_split = 0;
+  long cg_iterations_total = 0;
   StepStats last;
 
   std::unique_ptr<LinearSolver> make_solver() {
@@ -100,6 +101,7 @@ struct Simulation::Impl {
     stroke.clear();
     steps = 0;
     cuts = tets_split = 0;
+    cg_iterations_total = 0;
     last = StepStats{};
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
@@ -129,6 +131,7 @@ struct Simulation::Impl {
     const CgResult r = model->solve(imposed);
     s.solve_ms += ms_since(t0);
     s.cg_iterations += r.iterations;
+    cg_iterations_total += r.iterations;
     s.residual = r.residual;
     return r.converged;
   }
@@ -341,6 +344,7 @@ ModelCounts Simulation::counts() const {
   c.cuts = impl_->cuts;
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
+  c.cg_iterations_total = impl_->cg_iterations_total;
   c.volume_initial = total_volume(impl_->initial.mesh);
   c.volume_final = total_volume(impl_->model->mesh());
   return c;

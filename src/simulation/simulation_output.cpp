@@ -29,7 +29,8 @@ std::string Simulation::stats_json(double total_ms) {
   j["free_pieces_held"] = c.free_pieces_held;
   j["volume_initial"] = c.volume_initial;
   j["volume_final"] = c.volume_final;
-  j["cg_iterations"] = s.cg_iterations;
+  j["cg_iterations"] = c.cg_iterations_total;  // the whole run: initial equilibrium + steps
+  j["cg_iterations_last_step"] = s.cg_iterations;
   j["residual"] = s.residual;
   j["converged"] = s.converged;
   j["backend"] = backend();

@@ -129,6 +129,7 @@ TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
   EXPECT_EQ(j["cuts"], 0);
   EXPECT_GT(j["nodes_interface"].get<int>(), 0);
   EXPECT_LE(j["residual"].get<double>(), 1e-10);
+  EXPECT_GT(j["cg_iterations"].get<int>(), 0);  // the equilibrium took iterations
 }
 
 TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {

@@ -42,6 +42,7 @@ struct ModelCounts {
   int nodes = 0, tets = 0, dof_operation = 0, nodes_interface = 0;
   int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
   int cuts = 0, tets_split = 0, free_pieces_held = 0;
+  long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
   double volume_initial = 0, volume_final = 0;
 };
 
