@@ -37,13 +37,13 @@ TEST(SceneLoader, CantileverExample) {
   const Scene s = load_scene(kScenes + "cantilever.yaml");
   ASSERT_TRUE(s.generator);
   EXPECT_EQ(s.generator->type, "box");
-  EXPECT_EQ(s.mesh.num_nodes(), 11 * 3 * 3);
-  EXPECT_EQ(s.mesh.num_tets(), 10 * 2 * 2 * 6);
-  EXPECT_EQ(s.fixed[0].select(s.mesh).size(), 9u);
+  EXPECT_EQ(s.mesh.num_nodes(), 21 * 5 * 5);
+  EXPECT_EQ(s.mesh.num_tets(), 20 * 4 * 4 * 6);
+  EXPECT_EQ(s.fixed[0].select(s.mesh).size(), 25u);
   ASSERT_EQ(s.loads.size(), 1u);
   EXPECT_TRUE(s.loads[0].total);
-  EXPECT_EQ(s.loads[0].where.select(s.mesh).size(), 9u);
-  ASSERT_EQ(s.trajectory.size(), 3u);
+  EXPECT_EQ(s.loads[0].where.select(s.mesh).size(), 25u);
+  ASSERT_EQ(s.trajectory.size(), 6u);
   // The edge (local +x) points along world +z, the blade normal (local y) along world x.
   const Eigen::Matrix3d r = s.trajectory[0].orientation.toRotationMatrix();
   EXPECT_NEAR((r.col(0) - Vec3::UnitZ()).norm(), 0, 1e-12);
