@@ -46,14 +46,6 @@ Gl& gl() {
   return g;
 }
 
-Vector random_vector(Eigen::Index n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Vector v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v[i] = u(rng);
-  return v;
-}
-
 // Matrices are built once per size and shared by all layouts.
 const SparseMatrix& table2(int dof, int max_row) {
   static std::map<std::pair<int, int>, SparseMatrix> cache;

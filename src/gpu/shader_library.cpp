@@ -13,6 +13,17 @@ namespace stc {
 namespace gpu {
 namespace {
 
+// The compiler or linker log of a shader or program (the getter pair differs).
+template <typename GetIv, typename GetLog>
+std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
+  GLint len = 0;
+  get_iv(object, GL_INFO_LOG_LENGTH, &len);
+  std::string log(std::size_t(len > 0 ? len : 1), '\0');
+  get_log(object, len, nullptr, &log[0]);
+  return log.c_str();  // drop the trailing NUL
+}
+
+
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -61,12 +72,9 @@ unsigned ShaderLibrary::compile(unsigned stage, const std::string& file) {
   GLint ok = 0;
   glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
   if (!ok) {
-    GLint len = 0;
-    glGetShaderiv(sh, GL_INFO_LOG_LENGTH, &len);
-    std::string log(std::size_t(len > 0 ? len : 1), '\0');
-    glGetShaderInfoLog(sh, len, nullptr, &log[0]);
+    const std::string log = info_log(sh, glGetShaderiv, glGetShaderInfoLog);
     glDeleteShader(sh);
-    throw std::runtime_error("shader compile failed: " + path + ": " + log.c_str());
+    throw std::runtime_error("shader compile failed: " + path + ": " + log);
   }
   return sh;
 }
@@ -91,12 +99,9 @@ unsigned ShaderLibrary::program(const std::string& fragment_file) {
   GLint ok = 0;
   glGetProgramiv(prog, GL_LINK_STATUS, &ok);
   if (!ok) {
-    GLint len = 0;
-    glGetProgramiv(prog, GL_INFO_LOG_LENGTH, &len);
-    std::string log(std::size_t(len > 0 ? len : 1), '\0');
-    glGetProgramInfoLog(prog, len, nullptr, &log[0]);
+    const std::string log = info_log(prog, glGetProgramiv, glGetProgramInfoLog);
     glDeleteProgram(prog);
-    throw std::runtime_error("shader link failed: " + fragment_file + ": " + log.c_str());
+    throw std::runtime_error("shader link failed: " + fragment_file + ": " + log);
   }
   programs_[fragment_file] = prog;
   return prog;

@@ -103,5 +103,13 @@ SparseMatrix table2_matrix(int dof, int max_row, unsigned seed) {
   return build(dof, t);
 }
 
+Vector random_vector(Eigen::Index n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vector v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v[i] = u(rng);
+  return v;
+}
+
 }  // namespace gpu
 }  // namespace stc

@@ -277,19 +277,29 @@ class GmshReader {
     return v;
   }
 
-  void read_v4_nodes() {
-    long long blocks, total;
+  // Gmsh 4.1 $Nodes / $Elements header: numBlocks numItems minTag maxTag (four size_t in
+  // binary). `min_bytes_per_item` bounds the ASCII item count by the file size.
+  void read_v4_section_header(const std::string& what, int min_bytes_per_item,
+                              long long& blocks, long long& total) {
     if (binary_) {
       c_.skip_past_newline();
-      const char* p = c_.raw(32, "node section header");
+      const std::string header = what + " section header";
+      const char* p = c_.raw(32, header.c_str());
       blocks = static_cast<long long>(std::min<std::uint64_t>(size_t_value(p), 1ull << 40));
       total = static_cast<long long>(std::min<std::uint64_t>(size_t_value(p), 1ull << 40));
     } else {
-      blocks = count("number of node blocks", 4);
-      total = count("node count", 8);
-      c_.integer("minimum node tag");
-      c_.integer("maximum node tag");
+      const std::string n_blocks = "number of " + what + " blocks", n_items = what + " count";
+      const std::string min_tag = "minimum " + what + " tag", max_tag = "maximum " + what + " tag";
+      blocks = count(n_blocks.c_str(), 4);
+      total = count(n_items.c_str(), static_cast<std::size_t>(min_bytes_per_item));
+      c_.integer(min_tag.c_str());
+      c_.integer(max_tag.c_str());
     }
+  }
+
+  void read_v4_nodes() {
+    long long blocks, total;
+    read_v4_section_header("node", 8, blocks, total);
     long long seen = 0;
     for (long long b = 0; b < blocks; ++b) {
       long long dim, parametric, n;
@@ -350,17 +360,7 @@ class GmshReader {
 
   void read_v4_elements() {
     long long blocks, total;
-    if (binary_) {
-      c_.skip_past_newline();
-      const char* p = c_.raw(32, "element section header");
-      blocks = static_cast<long long>(std::min<std::uint64_t>(size_t_value(p), 1ull << 40));
-      total = static_cast<long long>(std::min<std::uint64_t>(size_t_value(p), 1ull << 40));
-    } else {
-      blocks = count("number of element blocks", 4);
-      total = count("element count", 4);
-      c_.integer("minimum element tag");
-      c_.integer("maximum element tag");
-    }
+    read_v4_section_header("element", 4, blocks, total);
     long long seen = 0;
     for (long long b = 0; b < blocks; ++b) {
       long long type, n;

@@ -4,6 +4,8 @@
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
+#include "test_meshes.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,12 +14,7 @@
 namespace stc {
 namespace {
 
-TetMesh cube_mesh() {
-  GeneratorParams g;
-  g.size = Vec3(0.04, 0.04, 0.04);
-  g.cells = {4, 4, 4};
-  return make_box_mesh(g);
-}
+using testing_meshes::cube_mesh;
 
 TEST(CollisionBvh, SegmentCandidatesMatchBruteForceOnTheDeformedThigh) {
   const Scene scene = make_thigh_scene();

@@ -6,18 +6,14 @@
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
+#include "test_meshes.hpp"
+
 #include <gtest/gtest.h>
 
 namespace stc {
 namespace {
 
-// 4 cm cube, 1 cm cells.
-TetMesh cube_mesh() {
-  GeneratorParams g;
-  g.size = Vec3(0.04, 0.04, 0.04);
-  g.cells = {4, 4, 4};
-  return make_box_mesh(g);
-}
+using testing_meshes::cube_mesh;
 
 // A blade whose edge runs along world +z from the tip and whose normal is world +x: it cuts
 // the plane x = const when moved along y.

@@ -12,13 +12,7 @@
 namespace stc {
 namespace {
 
-Vector random_vector(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Vector v(n);
-  for (int i = 0; i < n; ++i) v[i] = u(rng);
-  return v;
-}
+using gpu::random_vector;
 
 // Reference: A_ff x_f = b_f - A_fc x_c by sparse LDL^T in double.
 Vector reference_solve(const SparseMatrix& a, const Vector& b, const Vector& x0,

@@ -14,14 +14,6 @@ namespace stc {
 namespace gpu {
 namespace {
 
-Vector random_vector(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Vector v(n);
-  for (int i = 0; i < n; ++i) v[i] = u(rng);
-  return v;
-}
-
 class GpuSpmv : public ::testing::TestWithParam<SpmvLayout> {
  protected:
   void SetUp() override {

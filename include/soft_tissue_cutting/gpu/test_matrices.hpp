@@ -18,6 +18,8 @@ int max_offdiag_row(const SparseMatrix& a);
 // Table 2 stand-in: `dof` DOF (multiple of 3) whose longest row has exactly `max_row`
 // off-diagonal non-zeros, reached by the dense interface block (plus a few padding links).
 SparseMatrix table2_matrix(int dof, int max_row, unsigned seed = 1);
+// Uniform in [-1, 1], reproducible from `seed` (right-hand sides and SpMV inputs).
+Vector random_vector(Eigen::Index n, unsigned seed);
 
 }  // namespace gpu
 }  // namespace stc
