@@ -14,17 +14,24 @@ export ROS_MASTER_URI="http://localhost:$port"
 log="${png%.png}_rviz.log"
 roslaunch -p "$port" soft_tissue_cutting tissue.launch scene:="$scene" rviz:=true >"$log" 2>&1 &
 launch=$!
-cleanup() { kill -INT "${marker:-}" "$launch" 2>/dev/null || true; wait 2>/dev/null || true; }
+cleanup() { kill -INT ${marker:-} ${player:-} "$launch" 2>/dev/null || true; wait 2>/dev/null || true; }
 trap cleanup EXIT
 # the scripted stroke, then the handle where the blade stopped
-until rosparam get /tissue/trajectory >/dev/null 2>&1; do sleep 0.5; done
+for _ in $(seq 120); do rosparam get /tissue/trajectory >/dev/null 2>&1 && break; sleep 0.5; done
 sleep 6  # rviz starts (~6 s on llvmpipe)
-rosrun soft_tissue_cutting trajectory_player.py _speed:=0.5 >>"$log" 2>&1
+# (the player stays up, idle, after the stroke: it is stopped once the stroke has played)
+rosrun soft_tissue_cutting trajectory_player.py _speed:=0.5 >"${log%.log}_player.log" 2>&1 &
+player=$!
+sleep 8
+kill -INT "$player"
+wait "$player" || true
+player=
 last=$(rosparam get /tissue/trajectory | /usr/bin/python3 -c '
 import sys, yaml; p = yaml.safe_load(sys.stdin)[-1]
 print(list(p["position"]), list(p.get("orientation", [0, 0, 0, 1])))')
 pos="${last%%] *}]" ori="[${last#*] [}"
-rosrun soft_tissue_cutting scalpel_marker.py _initial_position:="$pos" _initial_orientation:="$ori" >>"$log" 2>&1 &
+rosrun soft_tissue_cutting scalpel_marker.py _initial_position:="$pos" _initial_orientation:="$ori" \
+  >"${log%.log}_marker.log" 2>&1 &
 marker=$!
 sleep 6
 import -window root "$png"

@@ -80,7 +80,8 @@ std::string run_isolated(const std::string& path, const std::string& what,
   // fds: the answer; errs: the child's stderr (an assert()'s message, folded into the error
   // line instead of being printed).
   int fds[2], errs[2];
-  if (::pipe(fds) != 0) fail(path, 0, what + " failed: cannot create a pipe: " + std::strerror(errno));
+  if (::pipe(fds) != 0)
+    fail(path, 0, what + " failed: cannot create a pipe: " + std::strerror(errno));
   if (::pipe(errs) != 0) {
     ::close(fds[0]);
     ::close(fds[1]);
@@ -143,8 +144,9 @@ std::string run_isolated(const std::string& path, const std::string& what,
     fail(path, 0, what + " did not finish within " + limit + " s (stopped)");
   }
   if (WIFSIGNALED(status) || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || answer.empty())
-    fail(path, 0, what + " " + describe_status(status) + last_line(err) +
-                      " (the surface is probably degenerate, self-intersecting or badly scaled)");
+    fail(path, 0,
+         what + " " + describe_status(status) + last_line(err) +
+             " (the surface is probably degenerate, self-intersecting or badly scaled)");
   if (answer[0] == 'E') {
     const std::string message = answer.substr(1);
     // Messages from fail() in the child already name the file.

@@ -109,58 +109,63 @@ RawMesh tetrahedralize_surface(const std::string& path, const Surface& surface,
     if (!x.allFinite()) fail(path, 0, "surface has a non-finite vertex");
 
   // Everything TetGen touches happens in the child; only the packed result comes back.
-  const std::string answer = run_isolated(path, "TetGen", [&]() -> std::string {
-    tetgenio in, out;  // their destructors free the arrays allocated here (new[])
-    in.firstnumber = 0;
-    in.numberofpoints = static_cast<int>(used.size());
-    in.pointlist = new REAL[3 * used.size()];
-    for (std::size_t i = 0; i < used.size(); ++i)
-      for (int d = 0; d < 3; ++d) in.pointlist[3 * i + d] = used[i][d];
-    in.numberoffacets = static_cast<int>(surface.triangles.size());
-    in.facetlist = new tetgenio::facet[surface.triangles.size()];
-    for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
-      tetgenio::facet& f = in.facetlist[t];
-      tetgenio::init(&f);
-      f.numberofpolygons = 1;
-      f.polygonlist = new tetgenio::polygon[1];
-      tetgenio::init(&f.polygonlist[0]);
-      f.polygonlist[0].numberofvertices = 3;
-      f.polygonlist[0].vertexlist = new int[3];
-      for (int k = 0; k < 3; ++k)
-        f.polygonlist[0].vertexlist[k] = remap[static_cast<std::size_t>(surface.triangles[t][k])];
-    }
+  const std::string answer = run_isolated(
+      path, "TetGen",
+      [&]() -> std::string {
+        tetgenio in, out;  // their destructors free the arrays allocated here (new[])
+        in.firstnumber = 0;
+        in.numberofpoints = static_cast<int>(used.size());
+        in.pointlist = new REAL[3 * used.size()];
+        for (std::size_t i = 0; i < used.size(); ++i)
+          for (int d = 0; d < 3; ++d) in.pointlist[3 * i + d] = used[i][d];
+        in.numberoffacets = static_cast<int>(surface.triangles.size());
+        in.facetlist = new tetgenio::facet[surface.triangles.size()];
+        for (std::size_t t = 0; t < surface.triangles.size(); ++t) {
+          tetgenio::facet& f = in.facetlist[t];
+          tetgenio::init(&f);
+          f.numberofpolygons = 1;
+          f.polygonlist = new tetgenio::polygon[1];
+          tetgenio::init(&f.polygonlist[0]);
+          f.polygonlist[0].numberofvertices = 3;
+          f.polygonlist[0].vertexlist = new int[3];
+          for (int k = 0; k < 3; ++k)
+            f.polygonlist[0].vertexlist[k] =
+                remap[static_cast<std::size_t>(surface.triangles[t][k])];
+        }
 
-    // Self-intersections are looked for first with TetGen's -d (detect) mode, which reports them
-    // instead of failing: TetGen 1.5.0 frees its pools twice when a meshing run ends in an error
-    // (terminatetetgen() and ~tetgenmesh() both call freememory()), which crashes the process.
-    {
-      tetgenbehavior detect;
-      char detect_switches[] = "dQ";
-      detect.parse_commandline(detect_switches);
-      tetgenio found;
-      try {
-        tetrahedralize(&detect, &in, &found);
-      } catch (int code) {
-        fail(path, 0, tetgen_error(code));
-      }
-      if (found.numberoftrifaces > 0)
-        fail(path, 0,
-             "the surface intersects itself (" + std::to_string(found.numberoftrifaces) +
-                 " intersecting triangles found by TetGen -d)");
-    }
+        // Self-intersections are looked for first with TetGen's -d (detect) mode, which reports
+        // them instead of failing: TetGen 1.5.0 frees its pools twice when a meshing run ends in an
+        // error (terminatetetgen() and ~tetgenmesh() both call freememory()), which crashes the
+        // process.
+        {
+          tetgenbehavior detect;
+          char detect_switches[] = "dQ";
+          detect.parse_commandline(detect_switches);
+          tetgenio found;
+          try {
+            tetrahedralize(&detect, &in, &found);
+          } catch (int code) {
+            fail(path, 0, tetgen_error(code));
+          }
+          if (found.numberoftrifaces > 0)
+            fail(path, 0,
+                 "the surface intersects itself (" + std::to_string(found.numberoftrifaces) +
+                     " intersecting triangles found by TetGen -d)");
+        }
 
-    tetgenbehavior behavior;
-    std::vector<char> args(switches.begin(), switches.end());
-    args.push_back('\0');
-    if (!behavior.parse_commandline(args.data()))
-      fail(path, 0, "invalid TetGen switches " + quoted(switches));
-    try {
-      tetrahedralize(&behavior, &in, &out);
-    } catch (int code) {
-      fail(path, 0, tetgen_error(code));
-    }
-    return pack(out);
-  }, kTetgenTimeoutS);
+        tetgenbehavior behavior;
+        std::vector<char> args(switches.begin(), switches.end());
+        args.push_back('\0');
+        if (!behavior.parse_commandline(args.data()))
+          fail(path, 0, "invalid TetGen switches " + quoted(switches));
+        try {
+          tetrahedralize(&behavior, &in, &out);
+        } catch (int code) {
+          fail(path, 0, tetgen_error(code));
+        }
+        return pack(out);
+      },
+      kTetgenTimeoutS);
   int header[3];
   std::size_t at = 0;
   if (answer.size() < sizeof header) fail(path, 0, "TetGen returned a truncated result");
@@ -168,10 +173,10 @@ RawMesh tetrahedralize_surface(const std::string& path, const Surface& surface,
   const int points = header[0], tets = header[1], corners = header[2];
   if (tets <= 0 || corners < 4 || points < 4)
     fail(path, 0, "TetGen produced no tetrahedra (is the surface closed and non-degenerate?)");
-  const std::size_t expected = sizeof header + 3 * sizeof(REAL) * static_cast<std::size_t>(points) +
-                               sizeof(int) * static_cast<std::size_t>(tets) *
-                                   static_cast<std::size_t>(corners) +
-                               sizeof(int);
+  const std::size_t expected =
+      sizeof header + 3 * sizeof(REAL) * static_cast<std::size_t>(points) +
+      sizeof(int) * static_cast<std::size_t>(tets) * static_cast<std::size_t>(corners) +
+      sizeof(int);
   if (answer.size() != expected) fail(path, 0, "TetGen returned a truncated result");
   std::vector<REAL> pointlist(3 * static_cast<std::size_t>(points));
   std::vector<int> tetlist(static_cast<std::size_t>(tets) * static_cast<std::size_t>(corners));

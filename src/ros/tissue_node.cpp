@@ -14,6 +14,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <stdexcept>
 
@@ -314,7 +315,9 @@ void TissueNode::publish_surface_locked(const ros::Time& stamp) {
   m.header.frame_id = params_.frame_id;
   m.header.stamp = stamp;
   published_version_ = sim_->surface_version();
-  m.text = "surface_version " + std::to_string(published_version_);
+  // The surface state's version travels as the header's sequence number (roscpp sends it as
+  // set), not in `text`: rviz flags a TRIANGLE_LIST with text ("Non-empty text is ignored").
+  m.header.seq = static_cast<std::uint32_t>(published_version_);
   m.action = visualization_msgs::Marker::ADD;
   surface_pub_.publish(m);
   last_surface_pub_ = ros::WallTime::now();

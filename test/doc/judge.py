@@ -68,6 +68,28 @@ def wait_master():
     raise SystemExit("judge: no ROS master within %.0f s" % LIMIT_S)
 
 
+def rviz_marker_warnings(m):
+    """What rviz 1.14's marker checks (marker_utils.cpp) would put in the display's status for
+    this TRIANGLE_LIST (they turn the "Tissue surface" display's status to Warn/Error)."""
+    out = []
+    if m.text:
+        out.append("non-empty text (rviz: 'Non-empty text is ignored.')")
+    if len(m.points) % 3:
+        out.append("points not a multiple of 3")
+    if m.colors and len(m.colors) != len(m.points):
+        out.append("%d colours for %d points" % (len(m.colors), len(m.points)))
+    q = m.pose.orientation
+    if abs(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w - 1.0) > 1e-3:
+        out.append("pose orientation not a unit quaternion")
+    if min(m.scale.x, m.scale.y, m.scale.z) <= 0:
+        out.append("scale not positive")
+    if m.mesh_resource:
+        out.append("non-empty mesh_resource")
+    if any(c.a <= 0 for c in m.colors) or (not m.colors and m.color.a <= 0):
+        out.append("zero alpha")
+    return out
+
+
 def judge_surface(args):
     box, _ = latest("/tissue/surface", Marker)
 
@@ -76,7 +98,10 @@ def judge_surface(args):
         return (m is not None and m.type == Marker.TRIANGLE_LIST and len(m.points) >= 300 and
                 all(math.isfinite(v) for p in m.points for v in (p.x, p.y, p.z)))
     wait_for("/tissue/surface TRIANGLE_LIST with >= 100 finite triangles", good)
-    line = "surface with %d triangles" % (len(box["msg"].points) // 3)
+    problems = rviz_marker_warnings(box["msg"])
+    if problems:
+        raise SystemExit("judge: rviz would flag /tissue/surface: " + "; ".join(problems))
+    line = "surface with %d triangles, nothing rviz flags" % (len(box["msg"].points) // 3)
     if "--rviz" in args:
         wait_for("/rviz node", lambda: node_alive("/rviz"), 60)
         time.sleep(5)  # rviz has loaded its displays: still alive?

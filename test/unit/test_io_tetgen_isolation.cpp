@@ -68,15 +68,20 @@ INSTANTIATE_TEST_SUITE_P(
 // The isolation itself, independent of what TetGen does with a given input.
 TEST(IsolatedChild, ReturnsTheChildsBytes) {
   const std::string big(1 << 20, 'x');  // more than a pipe holds
-  EXPECT_EQ(io::run_isolated("f.obj", "job", [&] { return big + "end"; }, 60.0), big + "end");
+  EXPECT_EQ(io::run_isolated(
+                "f.obj", "job", [&] { return big + "end"; }, 60.0),
+            big + "end");
 }
 
 TEST(IsolatedChild, SignalBecomesOneLineNamingTheFile) {
   try {
-    io::run_isolated("f.obj", "TetGen", []() -> std::string {
-      std::raise(SIGSEGV);
-      return "";
-    }, 60.0);
+    io::run_isolated(
+        "f.obj", "TetGen",
+        []() -> std::string {
+          std::raise(SIGSEGV);
+          return "";
+        },
+        60.0);
     FAIL() << "no error";
   } catch (const MeshError& e) {
     expect_one_line_naming(e.what(), "f.obj", "TetGen crashed (signal 11, SIGSEGV)");
@@ -85,7 +90,8 @@ TEST(IsolatedChild, SignalBecomesOneLineNamingTheFile) {
 
 TEST(IsolatedChild, ExceptionMessageComesBack) {
   try {
-    io::run_isolated("f.obj", "TetGen", []() -> std::string { throw 3; }, 60.0);
+    io::run_isolated(
+        "f.obj", "TetGen", []() -> std::string { throw 3; }, 60.0);
     FAIL() << "no error";
   } catch (const MeshError& e) {
     EXPECT_STREQ(e.what(), "f.obj: TetGen failed: error code 3");
@@ -94,9 +100,12 @@ TEST(IsolatedChild, ExceptionMessageComesBack) {
 
 TEST(IsolatedChild, TimeoutKillsTheChild) {
   try {
-    io::run_isolated("f.obj", "TetGen", []() -> std::string {
-      for (;;) pause();
-    }, 0.3);
+    io::run_isolated(
+        "f.obj", "TetGen",
+        []() -> std::string {
+          for (;;) pause();
+        },
+        0.3);
     FAIL() << "no error";
   } catch (const MeshError& e) {
     EXPECT_STREQ(e.what(), "f.obj: TetGen did not finish within 0.3 s (stopped)");
@@ -108,8 +117,9 @@ TEST(IsolatedChild, TimeoutKillsTheChild) {
 TEST(TetgenBadSurface, SolveExitsWithOneLine) {
   test::TempDir dir;
   const std::string scene = test::write_file(
-      dir.file("scene.yaml"), "mesh: {file: " + kBad + "flat_cube.obj}\n"
-                              "material: {young_modulus: 3000.0, poisson_ratio: 0.45}\n");
+      dir.file("scene.yaml"), "mesh: {file: " + kBad +
+                                  "flat_cube.obj}\n"
+                                  "material: {young_modulus: 3000.0, poisson_ratio: 0.45}\n");
   const std::string err = dir.file("err.txt");
   const std::string cmd = std::string(TISSUE_SOLVE_BIN) + " " + scene + " --out " +
                           dir.file("o.vtk") + " 2>" + err + " >/dev/null";
@@ -119,7 +129,8 @@ TEST(TetgenBadSurface, SolveExitsWithOneLine) {
   std::string text = test::read_text(err);
   while (!text.empty() && text.back() == '\n') text.pop_back();
   EXPECT_EQ(text.find('\n'), std::string::npos) << text;
-  EXPECT_NE(text.find(kBad + "flat_cube.obj: TetGen crashed (signal 6, SIGABRT)"), std::string::npos)
+  EXPECT_NE(text.find(kBad + "flat_cube.obj: TetGen crashed (signal 6, SIGABRT)"),
+            std::string::npos)
       << text;
 }
 #endif
