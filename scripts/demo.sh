@@ -33,6 +33,9 @@ if [ "$scene" != thigh ]; then
     exit 1
   fi
 fi
+if [ "$scene" != thigh ] && ! grep -qE '^trajectory:' "$scene"; then
+  echo "demo: note: $(basename "$scene") has no 'trajectory': the node runs without a scalpel"
+fi
 seconds="${TISSUE_DEMO_SECONDS:-12}"
 bag="$OUT/demo.bag"
 rm -f "$bag" "$bag.active"

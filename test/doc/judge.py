@@ -160,7 +160,7 @@ def judge_scalpel_marker(args):
                 abs(blade[0].pose.position.x - target[0]) < 1e-6 and
                 abs(blade[0].pose.position.y - target[1]) < 1e-6 and
                 abs(blade[0].pose.position.z - target[2]) < 1e-6)
-        wait_for("tissue blade marker at the dragged pose", blade_moved, 30)
+        wait_for("tissue blade marker at the dragged pose", blade_moved)
         line += "; the tissue node's blade marker too"
     return line
 

@@ -56,8 +56,9 @@ if [ -f "$WORK/prefix/setup.bash" ]; then
         fi
         kill -INT $pid; wait $pid || true
         exit $rc' _ "$WORK/prefix" "$port" "$scene" "$log" "$ROOT" 2>&1) || rc=$?
-    if [ $rc -eq 0 ]; then record "installed node on $scene: $out" $((SECONDS - t)); else
-      record "installed node on $scene" $((SECONDS - t)) "$(echo "$out" | tail -2 | tr '\n' ' ') (log: $log)"; fi
+    local name="installed node on ${scene#"$share"/}"
+    if [ $rc -eq 0 ]; then record "$name: $(echo "$out" | sed 's/^judge [a-z_]*: //' | tr '\n' ';')" $((SECONDS - t))
+    else record "$name" $((SECONDS - t)) "$(echo "$out" | tail -2 | tr '\n' ' ') (log: $log)"; fi
   }
   run_scene thigh
   for scene in "$share"/config/scenes/*.yaml; do
