@@ -97,7 +97,8 @@ std::map<int, Vec3> EdgeContact::update(const SurfaceBvh& bvh, const TetMesh& me
       l.longest_edge = std::max(l.longest_edge, longest);
     }
   }
-  const Vec3 previous_e = (previous->heel - previous->tip).normalized();
+  const Eigen::Matrix3d previous_frame = blade_frame(*previous);
+  const Vec3 previous_e = previous_frame.col(0);
   const double previous_length = (previous->heel - previous->tip).norm();
   std::vector<EdgeHeldNode> captured;
   for (const auto& [v, l] : local) {
@@ -106,15 +107,22 @@ std::map<int, Vec3> EdgeContact::update(const SurfaceBvh& bvh, const TetMesh& me
     if (!box.contains(x)) continue;  // its triangles may lie partly outside the candidates
     const Vec3 n = l.normal.normalized();
     if (std::abs(e.dot(n)) > options_.max_edge_slope) continue;
+    // Depth is measured in the blade's plane, across the edge (where the node will be held):
+    // `out` is the blade's in-plane perpendicular on the skin's side. A blade lying on its
+    // flat (its plane near the tangent plane) has no edge pointing into the skin.
+    const Vec3 out = frame.col(2).dot(n) >= 0 ? Vec3(frame.col(2)) : Vec3(-frame.col(2));
+    if (out.dot(n) < options_.min_plane_alignment) continue;
     const double s = (x - edge.tip).dot(e);
     if (s < 0 || s > length) continue;
     const Vec3 r = x - (edge.tip + s * e);  // from the line to the node, across the edge
-    // Crossing along the normal: at or above the node before, below it now; or the blade,
-    // already below, has slid along its length under the node (it was past its end before).
+    // The line passed the node: at or above it before, below it now; or the blade, already
+    // below, has slid along its length under the node (it was past its end before).
+    const Vec3 previous_out = previous_frame.col(2).dot(n) >= 0 ? Vec3(previous_frame.col(2))
+                                                                : Vec3(-previous_frame.col(2));
     const double s_previous = (x - previous->tip).dot(previous_e);
     const Vec3 r_previous = x - (previous->tip + s_previous * previous_e);
     const bool was_beside = s_previous >= 0 && s_previous <= previous_length;
-    if (!(r.dot(n) > 0 && (r_previous.dot(n) <= 0 || !was_beside))) continue;
+    if (!(r.dot(out) > 0 && (r_previous.dot(previous_out) <= 0 || !was_beside))) continue;
     // Sideways = along the blade's normal (the blade is a plate in its x-z plane): the held
     // node keeps that offset and takes the line's place in the blade's plane.
     const double lateral = r.dot(frame.col(1));
@@ -123,7 +131,7 @@ std::map<int, Vec3> EdgeContact::update(const SurfaceBvh& bvh, const TetMesh& me
     h.node = v;
     h.offset_blade = Vec3(0, lateral, 0);
     h.touch_point = x;
-    h.touch_normal = n;
+    h.touch_normal = out;
     imposed[v] = edge.tip + s * e + frame * h.offset_blade - mesh.nodes[v];
     captured.push_back(h);
   }

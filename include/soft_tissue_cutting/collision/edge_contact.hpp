@@ -5,21 +5,21 @@
 // Edge (belly) contact, per surface node, so it does not depend on which triangle, edge or
 // vertex of the surface the edge happens to lie over:
 //   - CAPTURE: a node of the deformed operation-part skin (not a node of an incision wall) is
-//     captured when the edge LINE passes it between two poses: measured along the node's
-//     outward normal n, the line was at or above the node at the previous pose and is below
-//     it now (or, already below, the blade slid along its length until the node came beside
-//     it); the node must lie beside the segment (its projection within tip..heel) and
-//     within `lateral_reach` x (its longest surface edge) of the line sideways (along the
-//     blade's normal), so exactly the band of nodes under the blade is taken. An edge steeper than
-//     `max_edge_slope` to the surface (a plunge along the edge) is left to the tip anchor: it has
-//     no belly on the surface.
+//     captured when the edge LINE passes it between two poses: measured in the blade's plane
+//     across the edge (towards the skin's outside), the line was at or above the node at the
+//     previous pose and is below it now (or, already below, the blade slid along its length until
+//     the node came beside it); the node must lie beside the segment (its projection within
+//     tip..heel) and within `lateral_reach` x (its longest surface edge) of the line sideways
+//     (along the blade's normal), so exactly the band of nodes under the blade is taken. An edge
+//     steeper than `max_edge_slope` to the surface (a plunge along the edge) is left to the tip
+//     anchor: it has no belly on the surface.
 //   - HOLD: a held node sits ON the blade line: in the blade's plane it is on the line; its
 //     sideways offset (along the blade normal), fixed at capture, is kept (so a captured node
 //     is not yanked sideways: no force spike). Along the edge it is free: a
 //     blade drawn along its length slides under the node, and the indentation follows it.
 //   - RELEASE: when the blade has slid past the node (its projection leaves tip..heel), or
-//     when the line has withdrawn above the point where the node was touched (along the
-//     normal it had then): lifting the blade out lets go.
+//     when the line has withdrawn above the point where the node was touched (measured as
+//     at the capture): lifting the blade out lets go.
 // Tip contact (tip_contact.hpp) anchors the triangle the tip enters when the blade is steep
 // to it (a plunge along the edge, which has no belly on the skin); its three nodes follow the
 // tip and take precedence over edge holds.
@@ -42,16 +42,17 @@
 namespace stc {
 
 struct EdgeContactOptions {
-  double lateral_reach = 0.6;    // x the node's longest surface edge (>= 1/sqrt(3): no gaps)
-  double max_edge_slope = 0.87;  // |edge . n| above this (about 60 deg): no belly contact
-  double tip_reach = 0.5;        // x blade_length: how deep the tip may be to anchor
+  double lateral_reach = 0.6;        // x the node's longest surface edge (>= 1/sqrt(3): no gaps)
+  double max_edge_slope = 0.87;      // |edge . n| above this (about 60 deg): no belly contact
+  double min_plane_alignment = 0.5;  // blade plane within 60 deg of the skin normal
+  double tip_reach = 0.5;            // x blade_length: how deep the tip may be to anchor
 };
 
 struct EdgeHeldNode {
   int node = -1;
   Vec3 offset_blade = Vec3::Zero();   // sideways offset from the line, blade frame (0, y, 0)
   Vec3 touch_point = Vec3::Zero();    // deformed position when captured
-  Vec3 touch_normal = Vec3::UnitZ();  // outward unit normal there
+  Vec3 touch_normal = Vec3::UnitZ();  // the outward direction its depth was measured along
 };
 
 class EdgeContact {
