@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <unordered_map>
 
@@ -122,7 +123,10 @@ std::map<int, Vec3> EdgeContact::update(const SurfaceBvh& bvh, const TetMesh& me
     const double s_previous = (x - previous->tip).dot(previous_e);
     const Vec3 r_previous = x - (previous->tip + s_previous * previous_e);
     const bool was_beside = s_previous >= 0 && s_previous <= previous_length;
-    if (!(r.dot(out) > 0 && (r_previous.dot(previous_out) <= 0 || !was_beside))) continue;
+    // A node the blade's end slides under must be near the line already (the dimple's
+    // slope), not a node far above it that the end merely came level with.
+    const bool slid_under = !was_beside && r.dot(out) <= options_.max_entry_depth * l.longest_edge;
+    if (!(r.dot(out) > 0 && (r_previous.dot(previous_out) <= 0 || slid_under))) continue;
     // Sideways = along the blade's normal (the blade is a plate in its x-z plane): the held
     // node keeps that offset and takes the line's place in the blade's plane.
     const double lateral = r.dot(frame.col(1));
@@ -166,6 +170,66 @@ double sweep_area(const BladeEdge& from, const BladeEdge& to) {
   // The triangles (A0, B0, B1) and (A0, B1, A1), as cut_sweep.hpp splits the bilinear patch.
   return 0.5 * ((from.heel - from.tip).cross(to.heel - from.tip).norm() +
                 (to.heel - from.tip).cross(to.tip - from.tip).norm());
+}
+
+namespace {
+
+// Distance from p to triangle (a, b, c) (Ericson's closest point, 5.1.5).
+double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+}  // namespace
+
+double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEdge& from,
+                             const BladeEdge& to, double tolerance) {
+  const std::array<std::array<Vec3, 3>, 2> now = {
+      {{from.tip, from.heel, to.heel}, {from.tip, to.heel, to.tip}}};
+  std::vector<std::array<Vec3, 3>> before;
+  for (size_t k = 1; k < stroke.size(); ++k) {
+    const BladeEdge &a = stroke[k - 1], &b = stroke[k];
+    before.push_back({a.tip, a.heel, b.heel});
+    before.push_back({a.tip, b.heel, b.tip});
+  }
+  const double reach = tolerance * (from.heel - from.tip).norm();
+  // Interior sample points of each triangle (barycentric grid), weighted by its area.
+  constexpr int kGrid = 6;
+  double covered = 0, total = 0;
+  for (const auto& t : now) {
+    const double area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
+    if (area <= 0) continue;
+    int in = 0, n = 0;
+    for (int i = 0; i < kGrid; ++i)
+      for (int j = 0; i + j < kGrid; ++j, ++n) {
+        const double u = (i + 1.0 / 3) / kGrid, v = (j + 1.0 / 3) / kGrid;
+        const Vec3 p = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+        for (const auto& b : before)
+          if (distance_to_triangle(p, b[0], b[1], b[2]) <= reach) {
+            ++in;
+            break;
+          }
+      }
+    covered += area * in / n;
+    total += area;
+  }
+  return total > 0 ? covered / total : 0;
 }
 
 }  // namespace stc

@@ -54,9 +54,6 @@ struct Simulation::Impl {
 
   enum class BladeState { kFree, kPressing, kCutting } blade_state = BladeState::kFree;
   EdgeContact contact;  // the nodes the blade holds while pressing (tip and edge)
-  // Sweep area since the last sweep that changed the mesh: a blade moving through its own
-  // incision cuts nothing new, and after `stall_area` of that it is no longer cutting.
-  double swept_without_cut = 0, stall_area = 0;
   std::optional<BladePose> last_pose;
   std::vector<BladePose> stroke;  // poses of the current cutting stroke
 
@@ -100,8 +97,6 @@ struct Simulation::Impl {
     free_pieces_held = 0;
     blade_state = BladeState::kFree;
     contact.release();
-    swept_without_cut = 0;
-    stall_area = stall_sweep_area();
     last_pose.reset();
     stroke.clear();
     steps = 0;
@@ -193,18 +188,6 @@ struct Simulation::Impl {
     return n;
   }
 
-  // Two typical operation-part tet faces: moving this far through tissue always splits or
-  // marks something, so a blade that sweeps more without any change is in its own incision.
-  double stall_sweep_area() const {
-    const std::vector<std::uint8_t>& op = model->partition().operation_tet;
-    double volume = 0;
-    int n = 0;
-    for (int t = 0; t < model->mesh().num_tets(); ++t)
-      if (op.empty() || op[static_cast<size_t>(t)]) volume += cut_state.origin_volume[t], ++n;
-    const double h = std::cbrt(6 * volume / std::max(n, 1)) * 1.5;  // edge of a Kuhn tet
-    return 2 * h * h;
-  }
-
   bool edge_inside_tissue(const BladeEdge& edge) const {
     return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length, [&](const Vec3& p) {
       return inside_rest_tissue(model->mesh(), cut_state, p);
@@ -226,15 +209,15 @@ struct Simulation::Impl {
       if (blade_state == BladeState::kCutting) {
         // The tissue has yielded: the edge opens it wherever it is in the tissue (the belly
         // too, the tip may be outside). Lifted out, or sliding through its own incision
-        // (nothing new to cut), it is free again; a fresh press starts a new cut.
-        bool changed = false;
-        if (last_pose) {
-          changed = cut(*last_pose, *blade, s);
-          swept_without_cut =
-              changed ? 0 : swept_without_cut + sweep_area(blade_edge(*last_pose, length), edge);
-        }
+        // (this step's sweep lies in what the stroke has swept already), it is free again;
+        // a fresh press starts a new cut.
+        std::vector<BladeEdge> swept;
+        for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
+        const bool retracing =
+            last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
+        if (last_pose && !retracing) cut(*last_pose, *blade, s);
         stroke.push_back(*blade);
-        if (!edge_inside_tissue(edge) || swept_without_cut > stall_area) {
+        if (retracing || !edge_inside_tissue(edge)) {
           blade_state = BladeState::kFree;
           stroke.clear();
         }
@@ -265,7 +248,6 @@ struct Simulation::Impl {
       if (cutting_enabled && s.contact_force.norm() > scene.scalpel.cut_pressure) {
         blade_state = BladeState::kCutting;  // the tissue yields: the next motion cuts
         contact.release();
-        swept_without_cut = 0;
         stroke = {*blade};
       }
     }

@@ -45,6 +45,7 @@ struct EdgeContactOptions {
   double lateral_reach = 0.6;        // x the node's longest surface edge (>= 1/sqrt(3): no gaps)
   double max_edge_slope = 0.87;      // |edge . n| above this (about 60 deg): no belly contact
   double min_plane_alignment = 0.5;  // blade plane within 60 deg of the skin normal
+  double max_entry_depth = 0.15;     // x longest edge: deepest a node the end slides under may be
   double tip_reach = 0.5;            // x blade_length: how deep the tip may be to anchor
 };
 
@@ -103,5 +104,12 @@ bool edge_in_tissue(const BladeEdge& edge, double spacing, Inside inside) {
 
 // Area of the sweep between two edge positions (the two triangles cut_sweep inserts).
 double sweep_area(const BladeEdge& from, const BladeEdge& to);
+
+// How much of the sweep from `from` to `to` lies in the sweeps between consecutive edges of
+// `stroke` (0..1, by area; 0 for a sweep of no area): 1 when the blade moves back through
+// the incision it has just cut. Points count as covered within `tolerance` x the blade
+// length of an earlier sweep triangle.
+double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEdge& from,
+                             const BladeEdge& to, double tolerance = 1e-4);
 
 }  // namespace stc
