@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The headless demo (SPEC 2, `./tissue demo`, which builds and sources .build/devel/setup.bash
+# The headless demo (docs/SCENE.md "Commands", `./tissue demo`, which builds and sources
+# .build/devel/setup.bash
 # first): tissue_node on the built-in thigh + the scripted scalpel (trajectory_player.py)
 # + a bag recording, stopped with SIGINT so the bag closes cleanly; then a summary from the
 # bag, `rosbag info`, and a picture of the cut tissue rendered by rviz under Xvfb.

@@ -1,6 +1,6 @@
-// Closed surface -> tetrahedral mesh with the TetGen library (SPEC 3). The surface is checked
-// first (every edge in exactly two triangles) so an open surface gets a clear message instead
-// of whatever TetGen makes of it.
+// Closed surface -> tetrahedral mesh with the TetGen library (docs/SCENE.md "Meshes"). The surface
+// is checked first (every edge in exactly two triangles) so an open surface gets a clear message
+// instead of whatever TetGen makes of it.
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 
