@@ -1,12 +1,12 @@
-// GPU texture SpMV and whole-CG benchmarks (METHOD.md section 6; the paper's Table 2 in
-// section 7). Rows of Table 2 are synthesized: SPD matrices with the same DOF and the same
+// GPU texture SpMV and whole-CG benchmarks (docs/DESIGN.md section 9; the paper's Table 2 in
+// section 13). Rows of Table 2 are synthesized: SPD matrices with the same DOF and the same
 // longest row (off-diagonal non-zeros 188..237, reached by a dense interface block), run
 // with Method A, Method B, our one-pass RowLoop layout, and the CPU (Eigen CSR, double).
 // Then a scaling run of whole CG iterations at 10k, 100k, 1M DOF.
 //
 // The device is named in the context ("gl_renderer") and in each GPU label. On Mesa
 // llvmpipe (software rasterizer on the CPU) the numbers say nothing about real GPU speed,
-// only about pass overheads; RECIPES.md: llvmpipe is for correctness.
+// only about pass overheads; docs/DESIGN.md section 14: llvmpipe is for correctness.
 // Times are per SpMV / per CG iteration; use --benchmark_repetitions for medians.
 #include "soft_tissue_cutting/gpu/egl_context.hpp"
 #include "soft_tissue_cutting/gpu/gl_cg.hpp"

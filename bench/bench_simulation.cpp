@@ -1,6 +1,6 @@
-// Whole simulation steps on the built-in thigh (METHOD 5): the scripted scalpel presses and
-// then cuts. A cutting step = collision + cut insertion + re-assembly of the changed tets +
-// hybrid CG solve + surface recovery. Median and max over every cutting step of the stroke,
+// Whole simulation steps on the built-in thigh (docs/DESIGN.md section 10): the scripted scalpel
+// presses and then cuts. A cutting step = collision + cut insertion + re-assembly of the changed
+// tets + hybrid CG solve + surface recovery. Median and max over every cutting step of the stroke,
 // and tets added per cm of cut. (Issue 4's target: median under 5 ms on one core.) A cutting
 // step's solver share: CG iterations, and set_matrix (the Cholesky preconditioner's
 // factorization of the changed hybrid matrix) inside assembly_ms.

@@ -1,6 +1,7 @@
 // ./tissue solve SCENE.yaml [--out OUT.vtk] [--stats OUT.json] [--backend cpu|gl]
-// The offline run of SPEC section 4: load, precompute the condensation, play the scene's
-// trajectory (pressure-triggered cuts included), solve the final equilibrium, write outputs.
+// The offline run of docs/SCENE.md "Offline run": load, precompute the condensation, play the
+// scene's trajectory (pressure-triggered cuts included), solve the final equilibrium, write
+// outputs.
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 

@@ -29,7 +29,7 @@ CondensedPart condense_non_operation_part(const TetMesh& mesh,
   // N ordered S first, then Q: the surface rows of X are then one contiguous block.
   c.condensed_dofs = make_dof_map(n, concat(partition.surface, partition.interior), fixed_node);
   const auto& part2 = partition.condensed_tets;
-  // K^(2) blocks from part-2 tets only (METHOD 2).
+  // K^(2) blocks from part-2 tets only (docs/DESIGN.md section 3).
   const SparseMatrix k_ii = assemble_block(mesh, elements, part2, c.interface_dofs, c.interface_dofs);
   const SparseMatrix k_nn = assemble_block(mesh, elements, part2, c.condensed_dofs, c.condensed_dofs);
   c.K2_NI = assemble_block(mesh, elements, part2, c.condensed_dofs, c.interface_dofs);
@@ -53,7 +53,7 @@ CondensedPart condense_non_operation_part(const TetMesh& mesh,
   c.solution_operator = x.leftCols(ni);
   c.load_response = x.col(ni);
   const SparseMatrix k_in = c.K2_NI.transpose();
-  // K0 = K2_II - K2_IN X,  g0 = K2_IN K2_NN^-1 f_N   (METHOD 3)
+  // K0 = K2_II - K2_IN X,  g0 = K2_IN K2_NN^-1 f_N   (docs/DESIGN.md eqs. (8)-(9))
   c.K0 = Eigen::MatrixXd(k_ii);
   c.K0.noalias() -= k_in * c.solution_operator;
   c.K0 = 0.5 * (c.K0 + c.K0.transpose()).eval();  // symmetric to rounding

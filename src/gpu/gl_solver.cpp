@@ -1,7 +1,7 @@
 // GL backend of LinearSolver: GPU float CG + CPU double iterative refinement (see
-// gl_solver.hpp). float32's true-residual floor is ~1e-7 relative (RECIPES.md), so each
-// refinement step gains roughly that factor (less for ill-conditioned A) until the
-// requested tolerance.
+// gl_solver.hpp). float32's true-residual floor is ~1e-7 relative (docs/DESIGN.md section 14), so
+// each refinement step gains roughly that factor (less for ill-conditioned A) until the requested
+// tolerance.
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 
 #include "soft_tissue_cutting/gpu/egl_context.hpp"

@@ -1,6 +1,6 @@
 // Gmsh .msh reader: format 1 ($NOD/$ELM), 2.x and 4.1 ($Nodes/$Elements, entity blocks in
-// 4.1), ASCII and binary. Only tetrahedra (element type 4) are kept (SPEC 3); node tags may be
-// non-contiguous and are mapped to 0-based indices in file order.
+// 4.1), ASCII and binary. Only tetrahedra (element type 4) are kept (docs/SCENE.md "Meshes"); node
+// tags may be non-contiguous and are mapped to 0-based indices in file order.
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 

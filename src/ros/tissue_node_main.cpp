@@ -1,4 +1,4 @@
-// tissue_node: the ROS 1 face of the simulation (SPEC section 5). See tissue_node.hpp.
+// tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). See tissue_node.hpp.
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
 #include <ros/ros.h>

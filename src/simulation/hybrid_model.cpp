@@ -34,8 +34,8 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   elements_ = ElementStiffnessCache(mesh_, scene.material);
   timings_["element_stiffness"] = ms_since(t0);
 
-  // K0, g0 (METHOD 3). Loads on interface nodes stay with part 1 (they enter f_I below), so
-  // only f_N reaches the condensation.
+  // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
+  // below), so only f_N reaches the condensation.
   condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
   timings_["condensation_assembly"] = condensed_.assembly_ms;
   timings_["condensation_factor"] = condensed_.factor_ms;
@@ -69,7 +69,7 @@ void HybridModel::rebuild_hybrid_system() {
   for (int k = 0; k < idofs.rows(); ++k)
     interface_row_[static_cast<size_t>(k)] = dofs_.row_of[static_cast<size_t>(idofs.global_of[k])];
 
-  // K1 from part-1 tets, plus K0 on the interface block (eq. 17).
+  // K1 from part-1 tets, plus K0 on the interface block (docs/DESIGN.md eq. (10)).
   std::vector<Triplet> t;
   t.reserve(partition_.operation_tets.size() * 144 +
             static_cast<size_t>(condensed_.K0.size()));
@@ -117,7 +117,7 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
 }
 
 void HybridModel::recover_surface() {
-  // u_S = c_S + R u_I (METHOD 4).
+  // u_S = c_S + R u_I (docs/DESIGN.md eq. (12)).
   const Vector u_i = gather(u_, condensed_.interface_dofs);
   scatter(recovery_.recover(u_i), recovery_.surface_dofs, u_);
 }

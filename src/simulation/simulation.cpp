@@ -161,7 +161,8 @@ struct Simulation::Impl {
     return true;
   }
 
-  // SPEC 6: a piece severed from everything anchored is kept and held where it is.
+  // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
+  // it is.
   void hold_free_pieces() {
     for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
       for (int n : piece.nodes) {

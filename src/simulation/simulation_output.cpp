@@ -1,4 +1,4 @@
-// The offline outputs of SPEC section 4: the VTK state and the JSON statistics.
+// The offline outputs of docs/SCENE.md "Offline run": the VTK state and the JSON statistics.
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 

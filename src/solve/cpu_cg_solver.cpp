@@ -1,4 +1,4 @@
-// Preconditioned projected Conjugate Gradient in double precision (METHOD.md section 5 step 5),
+// Preconditioned projected Conjugate Gradient in double precision (docs/DESIGN.md section 6),
 // the CPU backend of solve/linear_solver.hpp.
 //
 // Projection: constrained DOFs keep the value x has on entry. The residual and search
@@ -11,7 +11,7 @@
 // Preconditioners z = M r (r is zero on constrained DOFs, and so is z):
 //   Jacobi:   M = P diag(A)^-1 P.
 //   Cholesky: M = P A^-1 P, A = L L^T factored by CHOLMOD in set_matrix, i.e. only when the
-//             hybrid matrix changes (construction, cuts, E changes; METHOD.md sections 3, 5).
+//             hybrid matrix changes (construction, cuts, E changes; docs/DESIGN.md sections 4, 6).
 //             On the free DOFs M is (A^-1)_ff = S^-1 with S = A_ff - A_fc A_cc^-1 A_cf (block
 //             inverse), so the preconditioned operator is S^-1 A_ff = I + S^-1 A_fc A_cc^-1 A_cf:
 //             the identity plus rank <= #constrained DOFs. CG therefore needs at most

@@ -1,4 +1,4 @@
-// The full model and the hybrid model against CalculiX C3D4 (docs/REFERENCES.md): the test
+// The full model and the hybrid model against CalculiX C3D4 (docs/DESIGN.md section 12): the test
 // writes the .inp deck, runs `ccx -i job` in a temporary directory and parses job.dat.
 // Pass: max nodal difference <= 1e-6 of the largest displacement (CalculiX prints 7 digits).
 #include "soft_tissue_cutting/assembly/full_model.hpp"
@@ -141,8 +141,8 @@ void check_against_calculix(const Scene& s, const char* name) {
               name, s.mesh.num_nodes(), s.mesh.num_tets(), umax, e_full, e_hybrid);
 }
 
-// docs/REFERENCES.md cantilever: 0.1 x 0.02 x 0.02 m, E = 1e4, nu = 0.3, x = 0 fixed, tip
-// force 1e-4 N (-z) spread over the x = L face by tributary area.
+// The cantilever of docs/DESIGN.md section 12: 0.1 x 0.02 x 0.02 m, E = 1e4, nu = 0.3, x = 0 fixed,
+// tip force 1e-4 N (-z) spread over the x = L face by tributary area.
 Scene cantilever_scene(std::array<int, 3> cells) {
   Scene s;
   s.source = "cantilever";

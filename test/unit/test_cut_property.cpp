@@ -1,7 +1,7 @@
 // Property tests of cut insertion: thousands of seeded random blade sweeps on the box, the
 // thigh's operation part and the SOFA liver, biased to the hard cases (through nodes, along
-// edges and faces, repeated, continued, severing). After EVERY sweep all SPEC 6 invariants
-// must hold (cutting/invariants.hpp).
+// edges and faces, repeated, continued, severing). After EVERY sweep all invariants of
+// docs/SCENE.md "Cut invariants" must hold (cutting/invariants.hpp).
 #include "soft_tissue_cutting/cutting/cut_measures.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"

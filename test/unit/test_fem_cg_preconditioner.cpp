@@ -1,5 +1,5 @@
 // The two preconditioners of the CPU projected CG (solve/linear_solver.hpp) on the thigh's
-// hybrid system (METHOD.md section 3, eq. 17): same solution as the direct CHOLMOD solve, with
+// hybrid system (docs/DESIGN.md eq. (10)): same solution as the direct CHOLMOD solve, with
 // and without constrained (contact) DOFs; the Cholesky preconditioner converges in about
 // #constrained iterations where Jacobi needs hundreds; matrices that cannot be factored fall
 // back observably instead of crashing.

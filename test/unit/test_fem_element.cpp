@@ -1,4 +1,5 @@
-// Linear tet element stiffness (METHOD.md section 1): symmetry, rigid-body null space, patch test.
+// Linear tet element stiffness (docs/DESIGN.md section 2): symmetry, rigid-body null space, patch
+// test.
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/global_assembly.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"

@@ -1,4 +1,4 @@
-// The "gl" LinearSolver (whole CG on the GPU + double refinement, METHOD.md section 6) on
+// The "gl" LinearSolver (whole CG on the GPU + double refinement, docs/DESIGN.md section 9) on
 // Mesa llvmpipe, against a direct double solve (Eigen SimplicialLDLT of the reduced system).
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/gpu/test_matrices.hpp"

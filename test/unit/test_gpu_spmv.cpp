@@ -1,6 +1,6 @@
-// Texture SpMV (METHOD.md section 6) on Mesa llvmpipe: Method A, Method B and the one-pass
-// RowLoop layout against a double-precision CPU SpMV. EGL must work here (RECIPES.md,
-// "Headless EGL compute"): a missing context is a failure, not a skip.
+// Texture SpMV (docs/DESIGN.md section 9) on Mesa llvmpipe: Method A, Method B and the one-pass
+// RowLoop layout against a double-precision CPU SpMV. EGL must work here (docs/DESIGN.md section
+// 14, "Headless EGL compute"): a missing context is a failure, not a skip.
 #include "soft_tissue_cutting/gpu/egl_context.hpp"
 #include "soft_tissue_cutting/gpu/gl_spmv.hpp"
 #include "soft_tissue_cutting/gpu/gl_vector.hpp"

@@ -1,5 +1,6 @@
-// The whole per-step pipeline (METHOD 5): contact, pressure-triggered cutting, solve, and the
-// contracts a cut leaves behind (SPEC 6), checked against the full uncondensed model.
+// The whole per-step pipeline (docs/DESIGN.md section 10): contact, pressure-triggered cutting,
+// solve, and the contracts a cut leaves behind (docs/SCENE.md "Cut invariants"), checked against
+// the full uncondensed model.
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
@@ -184,9 +185,9 @@ TEST(SimulationPipeline, RefusesBadInput) {
   EXPECT_EQ(sim.counts().cuts, 0);
 }
 
-// The shipped cantilever example is REFERENCES.md's beam: before its scalpel moves, the mean
-// tip deflection is the linear-tet figure 2.016e-4 m (Euler-Bernoulli: 2.5e-4 m); its
-// trajectory then presses into the top face, yields and cuts a slit across the bar.
+// The shipped cantilever example is the beam of docs/DESIGN.md section 12: before its scalpel
+// moves, the mean tip deflection is the linear-tet figure 2.016e-4 m (Euler-Bernoulli: 2.5e-4 m);
+// its trajectory then presses into the top face, yields and cuts a slit across the bar.
 TEST(SimulationPipeline, CantileverExampleMatchesReferenceThenCuts) {
   const Scene scene = load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/cantilever.yaml");
   Simulation sim(scene);

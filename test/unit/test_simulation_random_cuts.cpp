@@ -1,7 +1,8 @@
-// SPEC 6 at the simulation level: random blade sweeps through the thigh's operation part via
-// Simulation::cut_along (cut insertion + re-assembly + free pieces held + solve). After every
-// sweep: the geometric invariants, a symmetric hybrid matrix that is positive definite on the
-// free DOF (held pieces excluded: they are constrained), a converged finite solution.
+// docs/SCENE.md "Cut invariants" at the simulation level: random blade sweeps through the thigh's
+// operation part via Simulation::cut_along (cut insertion + re-assembly + free pieces held +
+// solve). After every sweep: the geometric invariants, a symmetric hybrid matrix that is positive
+// definite on the free DOF (held pieces excluded: they are constrained), a converged finite
+// solution.
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"

@@ -1,6 +1,6 @@
-// `./tissue solve` (SPEC section 4) run as a user runs it: the tissue_solve executable on
-// scene files, its VTK and JSON outputs parsed and checked against the contract and against
-// the full uncondensed model.
+// `./tissue solve` (docs/SCENE.md "Offline run") run as a user runs it: the tissue_solve executable
+// on scene files, its VTK and JSON outputs parsed and checked against the contract and against the
+// full uncondensed model.
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
@@ -148,7 +148,7 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
   EXPECT_EQ(static_cast<int>(v.points.size()), j["nodes"].get<int>());
   EXPECT_EQ(static_cast<int>(v.cells.size()), j["tets"].get<int>());
   for (const Vec3& d : v.displacement) ASSERT_TRUE(d.allFinite());
-  // Cells positively oriented (SPEC 4).
+  // Cells positively oriented (docs/SCENE.md "Offline run").
   for (const Tet& c : v.cells)
     ASSERT_GT((v.points[c[1]] - v.points[c[0]])
                   .dot((v.points[c[2]] - v.points[c[0]]).cross(v.points[c[3]] - v.points[c[0]])),

@@ -1,5 +1,5 @@
 // The general (uncondensed) model: K over every free DOF of the whole mesh. The reference the
-// hybrid model must equal (METHOD.md section 3: "exact, not an approximation"), and the
+// hybrid model must equal (docs/DESIGN.md section 4: "exact, not an approximation"), and the
 // "general model" of the paper's Table 1.
 #pragma once
 

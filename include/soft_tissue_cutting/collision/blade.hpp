@@ -1,6 +1,6 @@
-// The scalpel's cutting edge as a segment (SPEC 3 `scalpel`): the pose origin is the tip, the
-// edge runs from the tip along the pose's local +x for blade_length, the blade lies in its
-// local x-z plane, so its normal is the local y axis.
+// The scalpel's cutting edge as a segment (docs/SCENE.md "Scene file", `scalpel`): the pose origin
+// is the tip, the edge runs from the tip along the pose's local +x for blade_length, the blade lies
+// in its local x-z plane, so its normal is the local y axis.
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"

@@ -1,4 +1,4 @@
-// Blade-tissue contact (METHOD 5 steps 2-3), the simplest honest model: the cutting edge is
+// Blade-tissue contact (docs/DESIGN.md section 7), the simplest honest model: the cutting edge is
 // a segment, the tissue surface a triangle mesh at its deformed positions.
 //
 // A surface node of the operation part is TOUCHED when

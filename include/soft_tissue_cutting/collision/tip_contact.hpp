@@ -1,4 +1,4 @@
-// Contact between the blade tip and the surface of the operation part (METHOD 5 steps 2-3).
+// Contact between the blade tip and the surface of the operation part (docs/DESIGN.md section 7).
 //
 // Model: when the tip first enters the deformed surface of the operation part, the surface
 // triangle it touches is anchored to the tip. While the blade presses, that triangle's three
@@ -6,7 +6,7 @@
 // touch plus the tip's motion since), and the tissue's reaction on the blade is minus the
 // force the solve needs at those nodes. The contact ends when the tip withdraws above the point it
 // first touched (the deformed surface at that moment), along that surface's normal. A pure plunge therefore presses; the blade cuts only once the
-// reaction exceeds `cut_pressure` (SPEC 3).
+// reaction exceeds `cut_pressure` (docs/SCENE.md "Scene file").
 #pragma once
 
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"

@@ -1,4 +1,4 @@
-// The non-operation part (part 2) condensed onto the interface (METHOD.md section 3):
+// The non-operation part (part 2) condensed onto the interface (docs/DESIGN.md section 4):
 //   K0 = K2_II - K2_IN K2_NN^-1 K2_NI   (dense, over the free interface DOFs)
 //   g0 = K2_IN K2_NN^-1 f_N
 // computed once per session from one CHOLMOD supernodal factorization of K2_NN and one

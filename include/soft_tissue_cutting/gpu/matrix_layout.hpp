@@ -1,5 +1,5 @@
-// CPU-side packing of a symmetric sparse matrix into the texture layouts of METHOD.md
-// section 6. The diagonal is stored apart (its own texture, also used by Jacobi); only the
+// CPU-side packing of a symmetric sparse matrix into the texture layouts of docs/DESIGN.md
+// section 9. The diagonal is stored apart (its own texture, also used by Jacobi); only the
 // off-diagonal non-zeros go into Telement. Every row has one Tindex texel (start, count).
 //
 //  - Method A (paper): one non-zero per Telement texel, value and column packed in one texel

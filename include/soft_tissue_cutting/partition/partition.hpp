@@ -1,4 +1,4 @@
-// Operation part / non-operation part and the node sets O, I, S, Q (METHOD.md section 2).
+// Operation part / non-operation part and the node sets O, I, S, Q (docs/DESIGN.md section 3).
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"

@@ -1,4 +1,4 @@
-// Recovering the condensed part from the interface displacements (METHOD.md section 4):
+// Recovering the condensed part from the interface displacements (docs/DESIGN.md section 5):
 //   u_S = [K2_NN^-1 f_N]_S - [K2_NN^-1 K2_NI]_S u_I = c_S + R u_I     (every step, dense mat-vec)
 //   u_N = K2_NN^-1 (f_N - K2_NI u_I)                                  (interior Q, output only)
 #pragma once

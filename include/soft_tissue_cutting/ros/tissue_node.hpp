@@ -1,4 +1,4 @@
-// tissue_node: the ROS 1 face of the simulation (SPEC section 5). Thin: all physics is in
+// tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). Thin: all physics is in
 // stc::Simulation; this class owns the loop thread, the topics, services and parameters.
 //
 // Threads: the simulation loop runs in its own std::thread at ~rate; ROS callbacks (pose

@@ -1,4 +1,4 @@
-// The scene of SPEC.md section 3, as data. Loading and validation: scene_loader.hpp.
+// The scene of docs/SCENE.md "Scene file", as data. Loading and validation: scene_loader.hpp.
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
@@ -72,7 +72,7 @@ struct SolverParams {
   int max_iterations = 2000;
 };
 
-// Parameters of the built-in generators (SPEC 3 `mesh.generator`).
+// Parameters of the built-in generators (docs/SCENE.md "Scene file", `mesh.generator`).
 struct GeneratorParams {
   std::string type;  // "thigh" or "box"
   // thigh: a thick tube along z; the inner wall is the removed thighbone.

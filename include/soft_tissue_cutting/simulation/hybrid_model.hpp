@@ -1,6 +1,7 @@
-// The hybrid condensed finite element model (METHOD.md sections 2-4): the operation part
+// The hybrid condensed finite element model (docs/DESIGN.md sections 3-5): the operation part
 // (part 1) stays a sparse FE model that cutting may change; the non-operation part (part 2) is
-// condensed once onto the interface. Each step solves eq. 17 over the free DOFs of O u I,
+// condensed once onto the interface. Each step solves docs/DESIGN.md eq. (10) (the paper's eq. 17)
+// over the free DOFs of O u I,
 //   [K1_OO  K1_OI     ] [u_O]   [f_O     ]
 //   [K1_IO  K1_II + K0] [u_I] = [f_I - g0]
 // with the injectable LinearSolver (projected CG, warm-started), then recovers u_S = c_S + R u_I.
@@ -26,7 +27,7 @@ namespace stc {
 // Imposed displacements: node -> displacement (scalpel contact, held free pieces).
 using ImposedDisplacements = std::map<int, Vec3>;
 
-// Sizes for the stats (SPEC section 4); fixed nodes count in their set.
+// Sizes for the stats (docs/SCENE.md "Offline run"); fixed nodes count in their set.
 struct HybridModelCounts {
   int nodes = 0, tets = 0;
   int dof_operation = 0;  // rows of the hybrid system: free DOFs of O u I
@@ -90,7 +91,8 @@ class HybridModel {
   // hybrid_assembly, total.
   const std::map<std::string, double>& precompute_timings_ms() const { return timings_; }
 
-  // The assembled eq. 17 system and its DOF numbering (for tests and GPU backends).
+  // The assembled hybrid system (docs/DESIGN.md eq. (10)) and its DOF numbering (for tests and GPU
+  // backends).
   const SparseMatrix& hybrid_matrix() const { return a_; }
   const Vector& hybrid_rhs() const { return b_; }
   const DofMap& hybrid_dofs() const { return dofs_; }

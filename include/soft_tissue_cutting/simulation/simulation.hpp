@@ -1,4 +1,4 @@
-// One simulated surgical scene: the per-step pipeline of METHOD.md section 5 (collision,
+// One simulated surgical scene: the per-step pipeline of docs/DESIGN.md section 10 (collision,
 // contact, cutting, hybrid solve, surface recovery) behind a ROS-free facade. The ROS node
 // and the offline `./tissue solve` both drive this class.
 #pragma once
@@ -40,7 +40,7 @@ struct StepStats {
   double step_ms = 0;
 };
 
-// Sizes of the current state (after cuts), as SPEC section 4 names them.
+// Sizes of the current state (after cuts), as docs/SCENE.md "Offline run" names them.
 struct ModelCounts {
   int nodes = 0, tets = 0, dof_operation = 0, nodes_interface = 0;
   int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
@@ -56,7 +56,7 @@ struct CutOutcome {
 };
 
 // The visible deformed surface: operation-part surface including cut faces, plus the
-// condensed surface S (METHOD 5 step 6).
+// condensed surface S (docs/DESIGN.md eq. (12)).
 struct DeformedSurface {
   std::vector<Vec3> positions;        // deformed position of every mesh node
   std::vector<double> displacement;   // |u| per node, m
@@ -70,7 +70,7 @@ class Simulation {
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
-  // One step of METHOD 5 with the blade at `blade` (scene frame), or no scalpel.
+  // One step of docs/DESIGN.md section 10 with the blade at `blade` (scene frame), or no scalpel.
   StepStats step(const std::optional<BladePose>& blade);
   // Cut along consecutive poses regardless of cut_pressure (the ~cut service), then solve.
   CutOutcome cut_along(const std::vector<BladePose>& poses);
@@ -97,7 +97,7 @@ class Simulation {
 
   // Full displacement (3 x nodes), interior condensed nodes recovered (for output).
   Eigen::VectorXd full_displacement();
-  // SPEC section 4 outputs. Throw std::runtime_error with a one-line reason.
+  // docs/SCENE.md "Offline run" outputs. Throw std::runtime_error with a one-line reason.
   void write_vtk(const std::string& path);
   void write_stats_json(const std::string& path, double total_ms);
   std::string stats_json(double total_ms);
@@ -105,7 +105,8 @@ class Simulation {
   const std::map<std::string, double>& precompute_timings_ms() const;
   // The hybrid model behind the simulation (read-only: for tests and analysis).
   const HybridModel& model() const;
-  // Per tet: the volume of the input tet it descends from (its size class, SPEC 6).
+  // Per tet: the volume of the input tet it descends from (its size class, docs/SCENE.md "Cut
+  // invariants").
   const std::vector<double>& tet_size_classes() const;
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;

@@ -1,4 +1,4 @@
-// The linear solver behind the hybrid system (METHOD.md section 3, eq. 17; section 5 step 5):
+// The linear solver behind the hybrid system (docs/DESIGN.md eq. (10), section 6):
 // a symmetric positive definite sparse matrix solved by Conjugate Gradient, warm-started.
 // Backends: CPU (solve/) and GPU textures through headless EGL (gpu/).
 #pragma once
@@ -17,7 +17,8 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using Vector = Eigen::VectorXd;
 
 struct CgSettings {
-  double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (SPEC 3 solver.tolerance)
+  double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (docs/SCENE.md "Scene file",
+                             // `solver.tolerance`)
   int max_iterations = 2000;
 };
 
