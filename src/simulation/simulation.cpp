@@ -8,6 +8,7 @@
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
+#include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -62,6 +63,7 @@ struct Simulation::Impl {
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
   StepStats last;
+  StepTimes step_times;  // every step() since start(), by kind (stats JSON step_ms)
 
   std::unique_ptr<LinearSolver> make_solver() {
     const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
@@ -103,6 +105,7 @@ struct Simulation::Impl {
     cuts = tets_split = 0;
     cg_iterations_total = 0;
     last = StepStats{};
+    step_times.clear();
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
@@ -273,8 +276,12 @@ StepStats Simulation::step(const std::optional<BladePose>& blade) {
     throw std::invalid_argument("blade pose is not finite (NaN/Inf or a zero quaternion)");
   std::optional<BladePose> normalized = blade;
   if (normalized) normalized->orientation.normalize();
-  return impl_->step(normalized);
+  const StepStats s = impl_->step(normalized);
+  impl_->step_times.add(s);
+  return s;
 }
+
+const StepTimes& Simulation::step_times() const { return impl_->step_times; }
 
 CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
   CutOutcome out;
