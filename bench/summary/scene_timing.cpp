@@ -73,10 +73,18 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
 
   // The trajectory; the first pressing step's constraint is kept for the full model.
   const std::vector<BladePose> poses = substepped(scene.trajectory, step_m);
-  std::vector<double> pressing, cutting;
+  std::vector<double> pressing, cutting, refresh;
   bool recorded = false;
   for (const BladePose& p : poses) {
     const StepStats s = sim.step(p);
+    if (step_kind(s) != StepKind::kIdle) {
+      // The visible surface as a display would fetch it after this step (u_S recovered from
+      // u_I through the factor of K2_NN): timed apart, it is not part of the step.
+      const auto tr = Clock::now();
+      const DeformedSurface drawn = sim.surface();
+      refresh.push_back(ms_since(tr));
+      if (drawn.positions.empty()) throw std::runtime_error("empty surface");
+    }
     if (step_kind(s) == StepKind::kCutting) cutting.push_back(s.step_ms);
     if (step_kind(s) == StepKind::kPressing) {
       pressing.push_back(s.step_ms);
@@ -111,6 +119,7 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   j["idle"] = summary(idle);
   j["pressing"] = summary(pressing);
   j["cutting"] = summary(cutting);
+  j["surface_refresh_ms"] = summary(refresh);
   j["cuts"] = sim.counts().cuts;
   j["tets_after"] = sim.mesh().num_tets();
   j["trajectory_steps"] = poses.size();

@@ -7,6 +7,7 @@
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
 #include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
@@ -49,6 +50,7 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
+  OperationSurface boundary;  // the boundary after cuts from part 1 alone
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -108,6 +110,7 @@ struct Simulation::Impl {
     step_times.clear();
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
+    boundary.init(model->mesh(), model->partition().operation_tet);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
   }
@@ -154,7 +157,9 @@ struct Simulation::Impl {
     for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
       if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
     hold_free_pieces();
-    surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
+    const Partition& p = model->partition();
+    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
+                       p.operation_tet, displacements());
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
@@ -166,9 +171,12 @@ struct Simulation::Impl {
 
   // SPEC 6: a piece severed from everything anchored is kept and held where it is.
   void hold_free_pieces() {
-    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+    // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
+    // (its condensation is nonsingular), and those are anchored.
+    const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
+    for (const MeshPiece& piece : free_pieces(part1, anchored)) {
       for (int n : piece.nodes) {
-        held[n] = model->displacement().segment<3>(3 * n);
+        held[n] = model->operation_displacement().segment<3>(3 * n);
         anchored[static_cast<size_t>(n)] = 1;
       }
       ++free_pieces_held;
@@ -178,8 +186,10 @@ struct Simulation::Impl {
     }
   }
 
+  // O and I current, S as last recovered: the tree's operation triangles (the only ones
+  // contact looks at) are exact, and a step does not wait for the recovery of u_S.
   std::vector<Vec3> displacements() const {
-    const Vector& u = model->displacement();
+    const Vector& u = model->operation_displacement();
     std::vector<Vec3> out(static_cast<size_t>(model->mesh().num_nodes()));
     for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
     return out;
@@ -222,7 +232,7 @@ struct Simulation::Impl {
         if (blade_state == BladeState::kFree) {
           const double reach = 0.5 * scene.scalpel.blade_length;
           surface_tree.refit(model->mesh(), displacements());
-          anchor = find_contact(model->mesh(), model->displacement(),
+          anchor = find_contact(model->mesh(), model->operation_displacement(),
                                 operation_surface_near(tip, reach), tip, reach);
           if (anchor) blade_state = BladeState::kPressing;
         }

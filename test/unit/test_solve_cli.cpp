@@ -153,7 +153,9 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
     steps += k["n"].get<int>();
     EXPECT_GE(k["median"].get<double>(), 0.0) << kind;
     EXPECT_GE(k["max"].get<double>(), k["median"].get<double>()) << kind;
-    if (k["n"].get<int>() > 0) EXPECT_GT(k["max"].get<double>(), 0.0) << kind;
+    if (k["n"].get<int>() > 0) {
+      EXPECT_GT(k["max"].get<double>(), 0.0) << kind;
+    }
   }
   EXPECT_EQ(steps, static_cast<int>(load_scene("thigh").trajectory.size()));
   EXPECT_EQ(j["step_ms"]["cutting"]["n"].get<int>(), j["cuts"].get<int>());
