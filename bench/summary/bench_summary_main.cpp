@@ -87,6 +87,12 @@ int main(int argc, char** argv) {
                 h["idle_step_ms_median"].get<double>(), h["step_ms_median"].get<double>(),
                 h["cut_step_ms_median"].get<double>(), h["cut_step_ms_max"].get<double>(),
                 h.value("full_solve_ms_median", 0.0), h["peak_rss_mb"].get<double>());
+    const nlohmann::json& cpu = h["cpu_ms"];
+    std::printf("%-12s %8s %9s %6s %11.0f %9.3f %9.3f %9.2f %9.2f %9.2f   (processor time)\n",
+                "  cpu", "", "", "", cpu["precompute"].get<double>(),
+                cpu["idle_step_median"].get<double>(), cpu["step_median"].get<double>(),
+                cpu["cut_step_median"].get<double>(), cpu["cut_step_max"].get<double>(),
+                h.value("full_solve_cpu_ms_median", 0.0));
     std::fflush(stdout);
     if (c.name == "thigh1") paper = h;
     if (c.name == "liver_organ") organ = h;

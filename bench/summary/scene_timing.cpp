@@ -7,6 +7,7 @@
 
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,6 +50,14 @@ nlohmann::json summary(const std::vector<double>& ms) {
   return {{"n", s.n}, {"median", s.median}, {"max", s.max}};
 }
 
+// Processor time of this process (all its threads): on a machine shared with other jobs it
+// moves far less than wall time, so before/after ratios are read from it.
+double cpu_ms_now() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
 }  // namespace
 
 nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
@@ -57,8 +66,11 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   const Scene scene = c.load();
   j["mesh_ms"] = ms_since(t0);  // reading / TetGen, not part of the precompute
   t0 = Clock::now();
+  double c0 = cpu_ms_now();
   Simulation sim(scene);
   j["precompute_ms"] = ms_since(t0);  // condensation + hybrid factor + initial equilibrium
+  nlohmann::json cpu;
+  cpu["precompute"] = cpu_ms_now() - c0;
   const ModelCounts counts = sim.counts();
   j["name"] = c.name;
   j["tets"] = counts.tets;
@@ -68,15 +80,23 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   j["nodes_surface_condensed"] = counts.nodes_surface_condensed;
 
   // Idle: no blade, nothing changed since the last step.
-  std::vector<double> idle;
-  for (int k = 0; k < idle_steps; ++k) idle.push_back(sim.step(std::nullopt).step_ms);
+  std::vector<double> idle, idle_cpu;
+  for (int k = 0; k < idle_steps; ++k) {
+    c0 = cpu_ms_now();
+    idle.push_back(sim.step(std::nullopt).step_ms);
+    idle_cpu.push_back(cpu_ms_now() - c0);
+  }
 
   // The trajectory; the first pressing step's constraint is kept for the full model.
   const std::vector<BladePose> poses = substepped(scene.trajectory, step_m);
-  std::vector<double> pressing, cutting, refresh;
+  std::vector<double> pressing, cutting, refresh, pressing_cpu, cutting_cpu;
   bool recorded = false;
   for (const BladePose& p : poses) {
+    c0 = cpu_ms_now();
     const StepStats s = sim.step(p);
+    const double step_cpu = cpu_ms_now() - c0;
+    if (step_kind(s) == StepKind::kCutting) cutting_cpu.push_back(step_cpu);
+    if (step_kind(s) == StepKind::kPressing) pressing_cpu.push_back(step_cpu);
     if (step_kind(s) != StepKind::kIdle) {
       // The visible surface as a display would fetch it after this step (u_S recovered from
       // u_I through the factor of K2_NN): timed apart, it is not part of the step.
@@ -120,6 +140,11 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   j["pressing"] = summary(pressing);
   j["cutting"] = summary(cutting);
   j["surface_refresh_ms"] = summary(refresh);
+  cpu["idle_step_median"] = summarize_step_times(idle_cpu).median;
+  cpu["step_median"] = summarize_step_times(pressing_cpu).median;
+  cpu["cut_step_median"] = summarize_step_times(cutting_cpu).median;
+  cpu["cut_step_max"] = summarize_step_times(cutting_cpu).max;
+  j["cpu_ms"] = cpu;
   j["cuts"] = sim.counts().cuts;
   j["tets_after"] = sim.mesh().num_tets();
   j["trajectory_steps"] = poses.size();
@@ -155,16 +180,19 @@ nlohmann::json time_full(const BenchCase& c, const nlohmann::json& hybrid, int r
       constrained[static_cast<size_t>(r)] = 1;
     }
   }
-  std::vector<double> ms;
+  std::vector<double> ms, cpu;
   int iterations = 0;
   for (int k = 0; k < repetitions; ++k) {
     Vector x = start;
     t0 = Clock::now();
+    const double c0 = cpu_ms_now();
     const CgResult r = solver->solve(full.f, x, constrained, settings);
+    cpu.push_back(cpu_ms_now() - c0);
     ms.push_back(ms_since(t0));
     iterations = r.iterations;
   }
   j["full_solve_ms_median"] = summarize_step_times(ms).median;
+  j["full_solve_cpu_ms_median"] = summarize_step_times(cpu).median;
   j["full_cg_iterations"] = iterations;
   return j;
 }
