@@ -76,6 +76,21 @@ void check_press_idle_release(const Scene& scene, const char* name) {
       << name;
 }
 
+// A tighter tolerance is a change: the same step is solved again, to the new tolerance (plain
+// Jacobi CG, so the loose solve really is loose).
+TEST(HybridLazyRecovery, NewToleranceSolvesAgain) {
+  HybridModel h(make_thigh_scene(), make_cpu_solver(CgPreconditioner::kJacobi));
+  h.set_cg_settings(CgSettings{1e-3, 20000});
+  const CgResult loose = h.solve();
+  ASSERT_TRUE(loose.converged);
+  EXPECT_GT(loose.residual, 1e-9);
+  h.set_cg_settings(CgSettings{1e-12, 20000});
+  const CgResult tight = h.solve();
+  EXPECT_GT(tight.iterations, 0);
+  EXPECT_LE(tight.residual, 1e-12);
+  EXPECT_LE(error_vs_full(h, {}), 1e-9);
+}
+
 TEST(HybridLazyRecovery, ThighPressIdleRelease) {
   Scene s = make_thigh_scene();
   s.gravity = Vec3(0, -9.81, 0);

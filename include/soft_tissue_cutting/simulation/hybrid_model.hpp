@@ -87,7 +87,11 @@ class HybridModel {
 
   void set_solver(std::unique_ptr<LinearSolver> solver);
   const LinearSolver& solver() const { return *solver_; }
-  void set_cg_settings(const CgSettings& settings) { settings_ = settings; }
+  // New settings: the next solve runs even if nothing else changed (a tighter tolerance).
+  void set_cg_settings(const CgSettings& settings) {
+    settings_ = settings;
+    system_changed_ = true;
+  }
   const CgSettings& cg_settings() const { return settings_; }
 
   const TetMesh& mesh() const { return mesh_; }
