@@ -4,6 +4,7 @@
 // outputs.
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
+#include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -63,6 +64,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "tissue solve: t=%.3f: the blade reached the interface of the "
                      "condensed part; cutting stops there\n", pose.t);
     }
+    // step_ms times the trajectory's steps only, not the final equilibrium solve.
+    const stc::StepTimes trajectory_steps = sim.step_times();
     const stc::StepStats final_step = sim.step(std::nullopt);
     if (!final_step.converged)
       std::fprintf(stderr, "tissue solve: warning: CG did not converge (relative residual %.3g)\n",
@@ -70,7 +73,7 @@ int main(int argc, char** argv) {
     const double total_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!out.empty()) sim.write_vtk(out);
-    if (!stats.empty()) sim.write_stats_json(stats, total_ms);
+    if (!stats.empty()) sim.write_stats_json(stats, total_ms, &trajectory_steps);
     const stc::ModelCounts c = sim.counts();
     std::printf("solved %s: %d nodes, %d tets, %d cuts, %ld CG iterations in all, residual %.3g, "
                 "backend %s, %.1f ms\n",

@@ -8,6 +8,8 @@
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
+#include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -48,6 +50,7 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
+  OperationSurface boundary;  // the boundary after cuts from part 1 alone
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -62,6 +65,7 @@ struct Simulation::Impl {
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
   StepStats last;
+  StepTimes step_times;  // every step() since start(), by kind (stats JSON step_ms)
 
   std::unique_ptr<LinearSolver> make_solver() {
     const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
@@ -103,8 +107,10 @@ struct Simulation::Impl {
     cuts = tets_split = 0;
     cg_iterations_total = 0;
     last = StepStats{};
+    step_times.clear();
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
+    boundary.init(model->mesh(), model->partition().operation_tet);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
   }
@@ -151,7 +157,9 @@ struct Simulation::Impl {
     for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
       if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
     hold_free_pieces();
-    surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
+    const Partition& p = model->partition();
+    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
+                       p.operation_tet, displacements());
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
@@ -164,9 +172,12 @@ struct Simulation::Impl {
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
   // it is.
   void hold_free_pieces() {
-    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+    // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
+    // (its condensation is nonsingular), and those are anchored.
+    const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
+    for (const MeshPiece& piece : free_pieces(part1, anchored)) {
       for (int n : piece.nodes) {
-        held[n] = model->displacement().segment<3>(3 * n);
+        held[n] = model->operation_displacement().segment<3>(3 * n);
         anchored[static_cast<size_t>(n)] = 1;
       }
       ++free_pieces_held;
@@ -176,8 +187,10 @@ struct Simulation::Impl {
     }
   }
 
+  // O and I current, S as last recovered: the tree's operation triangles (the only ones
+  // contact looks at) are exact, and a step does not wait for the recovery of u_S.
   std::vector<Vec3> displacements() const {
-    const Vector& u = model->displacement();
+    const Vector& u = model->operation_displacement();
     std::vector<Vec3> out(static_cast<size_t>(model->mesh().num_nodes()));
     for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
     return out;
@@ -227,7 +240,8 @@ struct Simulation::Impl {
         std::optional<BladeEdge> previous;
         if (last_pose) previous = blade_edge(*last_pose, length);
         imposed =
-            contact.update(surface_tree, model->mesh(), model->displacement(), previous, edge);
+            contact.update(surface_tree, model->mesh(), model->operation_displacement(), previous,
+                           edge);
         blade_state = contact.empty() ? BladeState::kFree : BladeState::kPressing;
       }
       s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
@@ -280,8 +294,12 @@ StepStats Simulation::step(const std::optional<BladePose>& blade) {
     throw std::invalid_argument("blade pose is not finite (NaN/Inf or a zero quaternion)");
   std::optional<BladePose> normalized = blade;
   if (normalized) normalized->orientation.normalize();
-  return impl_->step(normalized);
+  const StepStats s = impl_->step(normalized);
+  impl_->step_times.add(s);
+  return s;
 }
+
+const StepTimes& Simulation::step_times() const { return impl_->step_times; }
 
 CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
   CutOutcome out;

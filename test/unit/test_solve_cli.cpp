@@ -144,6 +144,22 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
   EXPECT_GT(j["tets_split"].get<int>(), 0);
   EXPECT_NEAR(j["volume_final"].get<double>(), j["volume_initial"].get<double>(),
               1e-9 * j["volume_initial"].get<double>());
+  // step_ms (SPEC 4): the trajectory's steps by kind; every cut was inserted by one step.
+  ASSERT_TRUE(j.contains("step_ms"));
+  int steps = 0;
+  for (const char* kind : {"idle", "pressing", "cutting"}) {
+    const nlohmann::json& k = j["step_ms"][kind];
+    ASSERT_TRUE(k.contains("n") && k.contains("median") && k.contains("max")) << kind;
+    steps += k["n"].get<int>();
+    EXPECT_GE(k["median"].get<double>(), 0.0) << kind;
+    EXPECT_GE(k["max"].get<double>(), k["median"].get<double>()) << kind;
+    if (k["n"].get<int>() > 0) {
+      EXPECT_GT(k["max"].get<double>(), 0.0) << kind;
+    }
+  }
+  EXPECT_EQ(steps, static_cast<int>(load_scene("thigh").trajectory.size()));
+  EXPECT_EQ(j["step_ms"]["cutting"]["n"].get<int>(), j["cuts"].get<int>());
+  EXPECT_GT(j["step_ms"]["pressing"]["n"].get<int>(), 0);
   const Vtk v = read_output(dir / "o.vtk");
   EXPECT_EQ(static_cast<int>(v.points.size()), j["nodes"].get<int>());
   EXPECT_EQ(static_cast<int>(v.cells.size()), j["tets"].get<int>());

@@ -4,7 +4,8 @@
 // over the free DOFs of O u I,
 //   [K1_OO  K1_OI     ] [u_O]   [f_O     ]
 //   [K1_IO  K1_II + K0] [u_I] = [f_I - g0]
-// with the injectable LinearSolver (projected CG, warm-started), then recovers u_S = c_S + R u_I.
+// with the injectable LinearSolver (projected CG, warm-started). The condensed part's
+// displacements u_S, u_Q follow from u_I through the kept factor of K2_NN, on demand.
 // ROS-free; the Simulation facade drives it.
 #pragma once
 
@@ -46,8 +47,10 @@ class HybridModel {
   HybridModel& operator=(const HybridModel&) = delete;
 
   // One quasi-static step: the imposed DOFs become constrained DOFs of the projected CG, warm
-  // started from the current displacement; then u_S is recovered. Imposed nodes must be O or
-  // I nodes (std::invalid_argument otherwise); imposed components on fixed nodes are ignored.
+  // started from the current displacement. Imposed nodes must be O or I nodes
+  // (std::invalid_argument otherwise); imposed components on fixed nodes are ignored. With
+  // the system and the imposed displacements unchanged since the last solve, the last
+  // solution is returned at once (0 iterations): it is still exact.
   CgResult solve(const ImposedDisplacements& imposed = {});
 
   // Sum over `nodes` of (K u - f) of the whole model at the current solution: the force the
@@ -56,11 +59,18 @@ class HybridModel {
   // exactly part 2's K2_II u_I + K2_IN u_N - f2_I). Fixed DOFs and S/Q nodes contribute 0.
   Vec3 reaction_force(const std::vector<int>& nodes) const;
 
-  // 3n displacement. O, I, S are current after solve(); Q after recover_interior().
-  const Vector& displacement() const { return u_; }
+  // 3n displacement, every node current: O and I from the last solve, S and Q recovered
+  // from u_I through the factor of K2_NN when u_I moved since the last recovery (one sparse
+  // solve, at the rate the caller asks: display, output).
+  const Vector& displacement() const;
+  // O and I current; S and Q as last recovered (the per-step contact and cutting use this).
+  const Vector& operation_displacement() const { return u_; }
+  // Kept for callers of the former two-stage recovery: displacement() recovers Q too.
   void recover_interior();
+  // How many recoveries of u_S, u_Q ran (for tests and benchmarks).
+  long recoveries() const { return recoveries_; }
   // Zero displacement everywhere (the next solve starts cold).
-  void reset_displacement() { u_.setZero(); }
+  void reset_displacement();
 
   // Cutting hook: the operation part of mesh_for_cutting() was changed in place (tets
   // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
@@ -78,7 +88,11 @@ class HybridModel {
 
   void set_solver(std::unique_ptr<LinearSolver> solver);
   const LinearSolver& solver() const { return *solver_; }
-  void set_cg_settings(const CgSettings& settings) { settings_ = settings; }
+  // New settings: the next solve runs even if nothing else changed (a tighter tolerance).
+  void set_cg_settings(const CgSettings& settings) {
+    settings_ = settings;
+    system_changed_ = true;
+  }
   const CgSettings& cg_settings() const { return settings_; }
 
   const TetMesh& mesh() const { return mesh_; }
@@ -87,8 +101,7 @@ class HybridModel {
   HybridModelCounts counts() const;
   const CgResult& last_result() const { return last_; }
   // Precompute stages in ms: partition, element_stiffness, condensation_assembly,
-  // condensation_factor, condensation_solve, condensation_products, recovery_operator,
-  // hybrid_assembly, total.
+  // condensation_factor, condensation_solve, condensation_products, hybrid_assembly, total.
   const std::map<std::string, double>& precompute_timings_ms() const { return timings_; }
 
   // The assembled hybrid system (docs/DESIGN.md eq. (10)) and its DOF numbering (for tests and GPU
@@ -102,7 +115,6 @@ class HybridModel {
 
  private:
   void rebuild_hybrid_system();
-  void recover_surface();
 
   TetMesh mesh_;
   Vec3 gravity_ = Vec3::Zero();
@@ -111,13 +123,19 @@ class HybridModel {
   ElementStiffnessCache elements_;
   Partition partition_;
   CondensedPart condensed_;
-  SurfaceRecovery recovery_;
   double condensed_scale_ = 1.0;        // E now / E at condensation time
   DofMap dofs_;                         // hybrid system over free DOFs of O u I
   std::vector<int> interface_row_;      // free interface DOF k -> hybrid row
   SparseMatrix a_;
+  SparseMatrix k0_padded_;              // K0 as a sparse block (3|I|_free square), see rebuild
   Vector b_;
-  Vector u_;
+  // u_ is mutable for the on-demand recovery of its S and Q entries in displacement().
+  mutable Vector u_;
+  mutable Vector recovered_from_;        // u_I the S and Q entries were recovered from
+  mutable bool condensed_stale_ = true;  // u_I moved since then
+  mutable long recoveries_ = 0;
+  bool system_changed_ = true;           // matrix, rhs or u_ changed since the last solve
+  ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;
   CgSettings settings_;
   CgResult last_;

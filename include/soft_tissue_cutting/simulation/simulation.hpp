@@ -16,6 +16,7 @@
 namespace stc {
 
 class HybridModel;
+struct StepTimes;  // simulation/step_times.hpp
 
 struct SimulationOptions {
   std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
@@ -99,8 +100,12 @@ class Simulation {
   Eigen::VectorXd full_displacement();
   // docs/SCENE.md "Offline run" outputs. Throw std::runtime_error with a one-line reason.
   void write_vtk(const std::string& path);
-  void write_stats_json(const std::string& path, double total_ms);
-  std::string stats_json(double total_ms);
+  // `steps`: the step times for `step_ms`; nullptr = every step since the start (or reset).
+  void write_stats_json(const std::string& path, double total_ms,
+                        const StepTimes* steps = nullptr);
+  std::string stats_json(double total_ms, const StepTimes* steps = nullptr);
+  // Wall time of every step() since the start (or the last reset), by kind.
+  const StepTimes& step_times() const;
   // Precompute stage timings of the condensation (ms), as the hybrid model measured them.
   const std::map<std::string, double>& precompute_timings_ms() const;
   // The hybrid model behind the simulation (read-only: for tests and analysis).
