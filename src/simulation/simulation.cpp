@@ -39,8 +39,8 @@ bool tip_inside_tissue(const TetMesh& mesh, const CutState& state, const Vec3& t
 }  // namespace
 
 struct Simulation::Impl {
-  Scene initial;   // as loaded: reset() returns here
-  Scene scene;     // live parameters (cut pressure, E)
+  Scene initial;  // as loaded: reset() returns here
+  Scene scene;    // live parameters (cut pressure, E)
   SimulationOptions options;
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
@@ -61,10 +61,15 @@ struct Simulation::Impl {
   std::uint64_t steps = 0, surface_version = 0;
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
+  long solver_fallbacks = 0;
   StepStats last;
 
+  std::string requested_backend() const {
+    return options.backend.empty() ? scene.solver.backend : options.backend;
+  }
+
   std::unique_ptr<LinearSolver> make_solver() {
-    const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
+    const std::string wanted = requested_backend();
     backend = "cpu";
     renderer.clear();
     if (wanted == "gl") {
@@ -102,6 +107,7 @@ struct Simulation::Impl {
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
+    solver_fallbacks = 0;
     last = StepStats{};
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
@@ -119,8 +125,7 @@ struct Simulation::Impl {
     if (!floating.empty())
       throw std::invalid_argument(
           scene.source + ": the mesh has " + std::to_string(floating.size()) +
-          " piece(s) with no fixed node (the first has " +
-          std::to_string(floating[0].tets.size()) +
+          " piece(s) with no fixed node (the first has " + std::to_string(floating[0].tets.size()) +
           " tets): fix at least one node of every piece");
   }
 
@@ -133,6 +138,10 @@ struct Simulation::Impl {
     s.cg_iterations += r.iterations;
     cg_iterations_total += r.iterations;
     s.residual = r.residual;
+    s.solved_by = r.solved_by.empty() ? backend : r.solved_by;
+    s.fallback_reason = r.fallback_reason;
+    s.solver_message = r.message;
+    if (!r.fallback_reason.empty()) ++solver_fallbacks;
     return r.converged;
   }
 
@@ -345,6 +354,7 @@ ModelCounts Simulation::counts() const {
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
   c.cg_iterations_total = impl_->cg_iterations_total;
+  c.solver_fallbacks = impl_->solver_fallbacks;
   c.volume_initial = total_volume(impl_->initial.mesh);
   c.volume_final = total_volume(impl_->model->mesh());
   return c;
@@ -354,6 +364,7 @@ const StepStats& Simulation::last_stats() const { return impl_->last; }
 std::string Simulation::backend() const { return impl_->backend; }
 std::string Simulation::renderer() const { return impl_->renderer; }
 std::string Simulation::backend_note() const { return impl_->backend_note; }
+std::string Simulation::backend_requested() const { return impl_->requested_backend(); }
 std::vector<std::uint8_t> Simulation::tet_regions() const {
   return impl_->model->partition().operation_tet;
 }
