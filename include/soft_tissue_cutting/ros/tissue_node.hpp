@@ -40,8 +40,8 @@ struct NodeParams {
   std::string scene = "thigh";
   std::string frame_id = "tissue";
   double rate = 100.0;
-  std::string scalpel_frame;  // empty: poses come from the scalpel/pose topic
-  std::string backend;        // empty: the scene's solver.backend
+  std::string scalpel_frame;    // empty: poses come from the scalpel/pose topic
+  std::string backend;          // empty: the scene's solver.backend
   double max_pose_jump = 0.05;  // m
   double display_rate = 30.0;   // Hz, upper limit for ~surface / ~markers
   // If set, the node publishes ~frame_id as a static tf child of this frame (placed by
@@ -114,7 +114,8 @@ class TissueNode {
   // Loop bookkeeping (loop thread; read by diagnostics under stats_mutex_).
   std::mutex stats_mutex_;
   double achieved_rate_ = 0;
-  bool last_converged_ = true;
+  bool last_converged_ = true;  // false: a solve since the last /diagnostics did not converge
+  std::string solver_failure_;  // its one-line reason
   std::uint64_t steps_ = 0;
 
   // Display bookkeeping (under sim_mutex_).
