@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
         "solved %s: %d nodes, %d tets, %d cuts, %ld CG iterations in all, residual %.3g, "
         "backend %s, %.1f ms\n",
         scene_path.c_str(), c.nodes, c.tets, c.cuts, c.cg_iterations_total, final_step.residual,
-        final_step.solved_by.c_str(), total_ms);
+        (final_step.solved_by.empty() ? sim.backend() : final_step.solved_by).c_str(), total_ms);
     // docs/SCENE.md (solve contract): exit 3, after the outputs, when the final solve did not
     // converge.
     if (!final_step.converged) {

@@ -37,7 +37,8 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
     if (!std::isfinite(v)) throw std::runtime_error("~parent_transform has a non-finite number");
   if (!(p.rate > 0) || !std::isfinite(p.rate))
     throw std::runtime_error("~rate must be a positive number of steps per second");
-  if (!(p.max_pose_jump > 0)) throw std::runtime_error("~max_pose_jump must be positive (m)");
+  if (!(p.max_pose_jump > 0))
+    throw std::runtime_error("~max_pose_jump must be positive (m)");
   if (!(p.display_rate > 0)) throw std::runtime_error("~display_rate must be positive (Hz)");
   if (p.backend != "" && p.backend != "cpu" && p.backend != "gl")
     throw std::runtime_error("~backend must be cpu or gl, not '" + p.backend + "'");
@@ -132,8 +133,8 @@ TissueNode::TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams param
   if (params_.scalpel_frame.empty())
     pose_sub_ = nh_.subscribe("scalpel/pose", 10, &TissueNode::on_pose, this);
   else
-    ROS_INFO("tissue_node: scalpel pose from tf2 frame '%s' in '%s'", params_.scalpel_frame.c_str(),
-             params_.frame_id.c_str());
+    ROS_INFO("tissue_node: scalpel pose from tf2 frame '%s' in '%s'",
+             params_.scalpel_frame.c_str(), params_.frame_id.c_str());
 }
 
 TissueNode::~TissueNode() { stop(); }
@@ -260,15 +261,14 @@ void TissueNode::loop() {
       if (blade) blade->t = static_cast<double>(steps_) / params_.rate;
       const StepStats s = sim_->step(blade);
       if (s.reached_interface)
-        ROS_WARN_THROTTLE(2.0,
-                          "the blade reached the interface of the condensed part: cutting "
-                          "stops there (the cut stays inside the operation region)");
+        ROS_WARN_THROTTLE(2.0, "the blade reached the interface of the condensed part: cutting "
+                               "stops there (the cut stays inside the operation region)");
       if (!s.converged)
         ROS_ERROR_THROTTLE(2.0, "the solve did not converge this step: %s",
                            s.solver_message.c_str());
       if (!s.fallback_reason.empty()) ROS_WARN_THROTTLE(10.0, "%s", s.fallback_reason.c_str());
       const ros::Time stamp = ros::Time::now();
-      soft_tissue_cutting::SimStats stats =
+      soft_tissue_cutting::SimStats stats =  // backend: what solved (cpu if gl fell back)
           to_stats_msg(s, sim_->counts(), s.solved_by.empty() ? sim_->backend() : s.solved_by,
                        sim_->renderer(), rate);
       stats.header.stamp = stamp;
@@ -285,11 +285,11 @@ void TissueNode::loop() {
       const double min_gap = 1.0 / params_.display_rate;
       const bool changed = sim_->surface_version() != published_version_;
       const std::optional<BladePose> shown = pose_input_.latest();
-      const bool blade_moved = shown.has_value() != shown_blade_.has_value() ||
-                               (shown && (shown->position != shown_blade_->position ||
-                                          !shown->orientation.coeffs().isApprox(
-                                              shown_blade_->orientation.coeffs(), 0))) ||
-                               s.cutting != shown_cutting_;
+      const bool blade_moved =
+          shown.has_value() != shown_blade_.has_value() ||
+          (shown && (shown->position != shown_blade_->position ||
+                     !shown->orientation.coeffs().isApprox(shown_blade_->orientation.coeffs(), 0))) ||
+          s.cutting != shown_cutting_;
       if ((changed && (now - last_surface_pub_).toSec() >= min_gap) ||
           (now - last_surface_pub_).toSec() >= 1.0)
         publish_surface_locked(stamp);
@@ -344,8 +344,8 @@ void TissueNode::publish_markers_locked(const ros::Time& stamp, const DeformedSu
     array.markers.push_back(m);
   shown_blade_ = pose_input_.latest();
   shown_cutting_ = sim_->last_stats().cutting;
-  for (auto& m :
-       scalpel_markers(shown_blade_, sim_->scene().scalpel.blade_length, shown_cutting_).markers)
+  for (auto& m : scalpel_markers(shown_blade_, sim_->scene().scalpel.blade_length, shown_cutting_)
+                     .markers)
     array.markers.push_back(m);
   for (auto& m : array.markers) {
     m.header.frame_id = params_.frame_id;
@@ -398,8 +398,8 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
     pose_input_.clear();
     publish_surface_locked(ros::Time::now());
     res.success = true;
-    res.message =
-        "reset to the initial state (surface_version " + std::to_string(published_version_) + ")";
+    res.message = "reset to the initial state (surface_version " +
+                  std::to_string(published_version_) + ")";
   } catch (const std::exception& e) {
     res.success = false;
     res.message = std::string("reset failed: ") + e.what();
@@ -407,7 +407,8 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   return true;
 }
 
-bool TissueNode::on_set_cutting(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+bool TissueNode::on_set_cutting(std_srvs::SetBool::Request& req,
+                                std_srvs::SetBool::Response& res) {
   {
     std::lock_guard<std::mutex> lock(sim_mutex_);
     sim_->set_cutting_enabled(req.data);
@@ -418,8 +419,8 @@ bool TissueNode::on_set_cutting(std_srvs::SetBool::Request& req, std_srvs::SetBo
   }
   reconfigure_->updateConfig(config_);  // keep dynamic_reconfigure in step
   res.success = true;
-  res.message =
-      req.data ? "pressure-triggered cutting enabled" : "pressure-triggered cutting disabled";
+  res.message = req.data ? "pressure-triggered cutting enabled"
+                         : "pressure-triggered cutting disabled";
   return true;
 }
 
@@ -482,8 +483,8 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   if (!converged)
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "solver did not converge: " + failure);
   else if (!rate_kept)
-    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "rate not kept: %.1f of %.1f Hz", rate,
-                    params_.rate);
+    status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "rate not kept: %.1f of %.1f Hz",
+                    rate, params_.rate);
   else
     status.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running at %.1f Hz on %s", rate,
                     backend.c_str());

@@ -71,7 +71,8 @@ void HybridModel::rebuild_hybrid_system() {
 
   // K1 from part-1 tets, plus K0 on the interface block (eq. 17).
   std::vector<Triplet> t;
-  t.reserve(partition_.operation_tets.size() * 144 + static_cast<size_t>(condensed_.K0.size()));
+  t.reserve(partition_.operation_tets.size() * 144 +
+            static_cast<size_t>(condensed_.K0.size()));
   add_element_triplets(mesh_, elements_, partition_.operation_tets, dofs_.row_of, dofs_.row_of, t);
   for (int j = 0; j < idofs.rows(); ++j)
     for (int i = 0; i < idofs.rows(); ++i)
@@ -82,8 +83,7 @@ void HybridModel::rebuild_hybrid_system() {
 
   // Right-hand side: f_O, f_I - g0.
   b_ = gather(loads(), dofs_);
-  for (int k = 0; k < idofs.rows(); ++k)
-    b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
+  for (int k = 0; k < idofs.rows(); ++k) b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
   solver_->set_matrix(a_);
 }
 
@@ -150,9 +150,8 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   const int old_nodes = static_cast<int>(u_.size() / 3);
   const int n = mesh_.num_nodes();
   if (n - old_nodes != static_cast<int>(new_nodes.size()))
-    throw std::invalid_argument(
-        "HybridModel::update_operation_part: new_nodes does not match "
-        "the nodes appended to the mesh");
+    throw std::invalid_argument("HybridModel::update_operation_part: new_nodes does not match "
+                                "the nodes appended to the mesh");
   // New nodes: displacement interpolated from their parents (cut_result.hpp), unloaded.
   u_.conservativeResize(3 * n);
   point_loads_.conservativeResize(3 * n);
@@ -164,10 +163,8 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     if (nn.a < 0 || nn.a >= node || (split && (nn.b < 0 || nn.b >= node)))
       throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
     if (split) {
-      u_.segment<3>(3 * node) =
-          (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
-      fixed_[static_cast<size_t>(node)] =
-          fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
+      u_.segment<3>(3 * node) = (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
+      fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
     } else {
       u_.segment<3>(3 * node) = u_.segment<3>(3 * nn.a);
       fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)];
@@ -183,9 +180,8 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   // The condensed part must be untouched: same I, S, Q and part-2 tets.
   if (p.interface != partition_.interface || p.surface != partition_.surface ||
       p.interior != partition_.interior || p.condensed_tets != partition_.condensed_tets)
-    throw std::logic_error(
-        "HybridModel::update_operation_part: the change reached the "
-        "condensed (non-operation) part");
+    throw std::logic_error("HybridModel::update_operation_part: the change reached the "
+                           "condensed (non-operation) part");
   partition_ = std::move(p);
   rebuild_hybrid_system();
 }
@@ -194,8 +190,8 @@ void HybridModel::set_young_modulus(double young_modulus) {
   if (!(young_modulus > 0)) throw std::invalid_argument("young_modulus must be > 0");
   const double s = young_modulus / elements_.material().young_modulus;
   elements_.set_young_modulus(young_modulus);
-  condensed_.K0 *= s;  // K2 scales with E
-  recovery_.c_S /= s;  // [K2_NN^-1 f_N]_S scales with 1/E; R and g0 are ratios
+  condensed_.K0 *= s;        // K2 scales with E
+  recovery_.c_S /= s;        // [K2_NN^-1 f_N]_S scales with 1/E; R and g0 are ratios
   condensed_scale_ *= s;
   rebuild_hybrid_system();
 }

@@ -39,8 +39,8 @@ bool tip_inside_tissue(const TetMesh& mesh, const CutState& state, const Vec3& t
 }  // namespace
 
 struct Simulation::Impl {
-  Scene initial;  // as loaded: reset() returns here
-  Scene scene;    // live parameters (cut pressure, E)
+  Scene initial;   // as loaded: reset() returns here
+  Scene scene;     // live parameters (cut pressure, E)
   SimulationOptions options;
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
@@ -125,7 +125,8 @@ struct Simulation::Impl {
     if (!floating.empty())
       throw std::invalid_argument(
           scene.source + ": the mesh has " + std::to_string(floating.size()) +
-          " piece(s) with no fixed node (the first has " + std::to_string(floating[0].tets.size()) +
+          " piece(s) with no fixed node (the first has " +
+          std::to_string(floating[0].tets.size()) +
           " tets): fix at least one node of every piece");
   }
 

@@ -40,8 +40,8 @@ struct NodeParams {
   std::string scene = "thigh";
   std::string frame_id = "tissue";
   double rate = 100.0;
-  std::string scalpel_frame;    // empty: poses come from the scalpel/pose topic
-  std::string backend;          // empty: the scene's solver.backend
+  std::string scalpel_frame;  // empty: poses come from the scalpel/pose topic
+  std::string backend;        // empty: the scene's solver.backend
   double max_pose_jump = 0.05;  // m
   double display_rate = 30.0;   // Hz, upper limit for ~surface / ~markers
   // If set, the node publishes ~frame_id as a static tf child of this frame (placed by

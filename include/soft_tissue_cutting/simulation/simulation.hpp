@@ -25,7 +25,7 @@ struct SimulationOptions {
 struct StepStats {
   std::uint64_t step = 0;
   bool in_contact = false;
-  bool cutting = false;               // this step inserted a cut
+  bool cutting = false;          // this step inserted a cut
   Vec3 contact_force = Vec3::Zero();  // N, reaction of the tissue on the blade (scene frame)
   int cg_iterations = 0;
   double residual = 0;
@@ -35,9 +35,9 @@ struct StepStats {
   // fallback_reason says why in one line.
   std::string solved_by;
   std::string fallback_reason;
-  std::string solver_message;      // one line when !converged: why the solve stopped short
-  int tets_split = 0;              // this step
-  int nodes_added = 0;             // this step
+  std::string solver_message;  // one line when !converged: why the solve stopped short
+  int tets_split = 0;   // this step
+  int nodes_added = 0;  // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
   double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
   double step_ms = 0;
@@ -62,8 +62,8 @@ struct CutOutcome {
 // The visible deformed surface: operation-part surface including cut faces, plus the
 // condensed surface S (METHOD 5 step 6).
 struct DeformedSurface {
-  std::vector<Vec3> positions;       // deformed position of every mesh node
-  std::vector<double> displacement;  // |u| per node, m
+  std::vector<Vec3> positions;        // deformed position of every mesh node
+  std::vector<double> displacement;   // |u| per node, m
   std::vector<BoundaryTriangle> triangles;
 };
 
@@ -93,12 +93,12 @@ class Simulation {
   std::uint64_t surface_version() const;  // changes whenever the drawn surface changes
   ModelCounts counts() const;
   const StepStats& last_stats() const;
-  std::string backend() const;                    // solver actually in use: "cpu" or "gl"
-  std::string renderer() const;                   // GL renderer for "gl"
-  std::string backend_note() const;               // why gl fell back to cpu, if it did
-  std::string backend_requested() const;          // "cpu" or "gl": the option, else the scene's
+  std::string backend() const;   // solver actually in use: "cpu" or "gl"
+  std::string renderer() const;  // GL renderer for "gl"
+  std::string backend_note() const;  // why gl fell back to cpu, if it did
+  std::string backend_requested() const;  // "cpu" or "gl": the option, else the scene's
   std::vector<std::uint8_t> tet_regions() const;  // 1 = operation part, per tet
-  std::vector<BladePose> blade_path() const;      // poses of the current scalpel stroke
+  std::vector<BladePose> blade_path() const;       // poses of the current scalpel stroke
 
   // Full displacement (3 x nodes), interior condensed nodes recovered (for output).
   Eigen::VectorXd full_displacement();
