@@ -60,7 +60,9 @@ class GlSolver final : public LinearSolver {
     scaled_diagonal_ = scaled.diagonal();
     try {
       // Textures of unchanged size are patched in place (Texture::allocate keeps them).
-      spmv_->upload(gpu::pack_matrix(scaled, options_.layout, ctx_->max_texture_size()));
+      const int limit =
+          options_.max_texture_size > 0 ? options_.max_texture_size : ctx_->max_texture_size();
+      spmv_->upload(gpu::pack_matrix(scaled, options_.layout, limit));
     } catch (const std::exception& e) {
       unusable_ = e.what();  // e.g. beyond the texture size limit: solves go to the CPU
     }

@@ -197,5 +197,22 @@ TEST(GlRefinement, FloatLimitWithoutFallbackIsNotConverged) {
   EXPECT_NE(r.fallback_reason.find("float32"), std::string::npos) << r.fallback_reason;
 }
 
+TEST(GlRefinement, MatrixBeyondTheTextureLimitIsSolvedOnTheCpuWithAReason) {
+  const SparseMatrix a = gpu::elasticity_like(8 * 8 * 8, 8, 8);  // 1536 DOF: 64 x 24 texels
+  GlSolverOptions small;
+  small.max_texture_size = 16;
+  auto s = gl_solver(small);
+  ASSERT_TRUE(s);
+  s->set_matrix(a);  // does not throw: the solves go to the CPU
+  const Vector b = gpu::random_vector(a.rows(), 2);
+  Vector x = Vector::Zero(a.rows());
+  const CgSettings settings{1e-10, 2000};
+  const CgResult r = s->solve(b, x, {}, settings);
+  expect_honest(r, a, b, x, settings);
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.solved_by, "cpu");
+  EXPECT_NE(r.fallback_reason.find("texture size limit"), std::string::npos) << r.fallback_reason;
+}
+
 }  // namespace
 }  // namespace stc

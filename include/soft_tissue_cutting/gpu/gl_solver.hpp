@@ -36,6 +36,9 @@ struct GlSolverOptions {
   int poor_steps = 2;
   int max_refinements = 30;  // outer double-precision refinement steps, then fall back
   bool cpu_fallback = true;  // false: report the float-limited result as not converged
+  // Texture size limit for the matrix layout; 0: the device's GL_MAX_TEXTURE_SIZE (tests set
+  // a small one to exercise the too-big-for-textures fallback, which ignores cpu_fallback).
+  int max_texture_size = 0;
 };
 
 // Null when no GL context can be made (no EGL driver/device, or TISSUE_FORCE_NO_EGL=1);
