@@ -131,9 +131,11 @@ class CpuCgSolver final : public LinearSolver {
         if (!result.converged)
           result.message = result.iterations >= settings.max_iterations
                                ? iteration_cap_message(result, settings)
-                               : "CG broke down (the matrix is not positive definite on the free "
-                                 "DOFs?) at relative residual " +
-                                     format_residual(true_res);
+                               : "CG stopped gaining at relative residual " +
+                                     format_residual(true_res) + " (tolerance " +
+                                     format_residual(settings.tolerance) +
+                                     "): too ill-conditioned for double precision, or not "
+                                     "positive definite on the free DOFs";
         return result;
       }
     }
