@@ -268,11 +268,13 @@ void TissueNode::loop() {
         ROS_WARN_THROTTLE(2.0, "the blade reached the interface of the condensed part: cutting "
                                "stops there (the cut stays inside the operation region)");
       if (!s.converged)
-        ROS_WARN_THROTTLE(2.0, "CG did not converge this step (relative residual %.3g)",
-                          s.residual);
+        ROS_ERROR_THROTTLE(2.0, "the solve did not converge this step: %s",
+                           s.solver_message.c_str());
+      if (!s.fallback_reason.empty()) ROS_WARN_THROTTLE(10.0, "%s", s.fallback_reason.c_str());
       const ros::Time stamp = ros::Time::now();
-      soft_tissue_cutting::SimStats stats =
-          to_stats_msg(s, sim_->counts(), sim_->backend(), sim_->renderer(), rate);
+      soft_tissue_cutting::SimStats stats =  // backend: what solved (cpu if gl fell back)
+          to_stats_msg(s, sim_->counts(), s.solved_by.empty() ? sim_->backend() : s.solved_by,
+                       sim_->renderer(), rate);
       stats.header.stamp = stamp;
       stats.header.frame_id = params_.frame_id;
       stats_pub_.publish(stats);
@@ -304,7 +306,10 @@ void TissueNode::loop() {
         std::lock_guard<std::mutex> slock(stats_mutex_);
         ++steps_;
         achieved_rate_ = rate;
-        last_converged_ = s.converged;
+        if (!s.converged) {  // held until /diagnostics has reported it (diagnose)
+          last_converged_ = false;
+          solver_failure_ = s.solver_message;
+        }
       }
     }
     diagnostics_.update();
@@ -468,17 +473,25 @@ void TissueNode::on_reconfigure(soft_tissue_cutting::TissueConfig& config, uint3
 void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   double rate;
   bool converged;
+  std::string failure;
   std::uint64_t steps;
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     rate = achieved_rate_;
     converged = last_converged_;
+    failure = solver_failure_;
+    last_converged_ = true;  // reported now: the next period starts clean
     steps = steps_;
   }
   const bool rate_kept = rate >= 0.9 * params_.rate;
   const std::string backend = sim_->backend();  // const, set at construction
+  StepStats last;
+  {
+    std::lock_guard<std::mutex> lock(sim_mutex_);
+    last = sim_->last_stats();
+  }
   if (!converged)
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "solver did not converge");
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "solver did not converge: " + failure);
   else if (!rate_kept)
     status.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "rate not kept: %.1f of %.1f Hz",
                     rate, params_.rate);
@@ -492,6 +505,8 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("backend", backend);
   status.add("renderer", sim_->renderer());
   status.add("backend note", sim_->backend_note());
+  status.add("solved by", last.solved_by);  // cpu when a gl solve fell back
+  status.add("fallback reason", last.fallback_reason);
   status.add("steps", steps);
 }
 

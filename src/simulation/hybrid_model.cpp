@@ -119,7 +119,8 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
   if (dofs_.rows() > 0) {
     last_ = solver_->solve(b_, x, constrained, settings_);
   } else {
-    last_ = CgResult{0, 0.0, true};  // `none`: nothing to solve, u_S = c_S
+    last_ = CgResult{};  // `none`: nothing to solve, u_S = c_S
+    last_.converged = true;
   }
   scatter(x, dofs_, u_);
   // u_S and u_Q follow u_I alone: recovered on demand (displacement()), and only if u_I moved.

@@ -64,11 +64,16 @@ struct Simulation::Impl {
   std::uint64_t steps = 0, surface_version = 0;
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
+  long solver_fallbacks = 0;
   StepStats last;
   StepTimes step_times;  // every step() since start(), by kind (stats JSON step_ms)
 
+  std::string requested_backend() const {
+    return options.backend.empty() ? scene.solver.backend : options.backend;
+  }
+
   std::unique_ptr<LinearSolver> make_solver() {
-    const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
+    const std::string wanted = requested_backend();
     backend = "cpu";
     renderer.clear();
     if (wanted == "gl") {
@@ -106,6 +111,7 @@ struct Simulation::Impl {
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
+    solver_fallbacks = 0;
     last = StepStats{};
     step_times.clear();
     // The initial equilibrium under the scene's loads.
@@ -139,6 +145,10 @@ struct Simulation::Impl {
     s.cg_iterations += r.iterations;
     cg_iterations_total += r.iterations;
     s.residual = r.residual;
+    s.solved_by = r.solved_by.empty() ? backend : r.solved_by;
+    s.fallback_reason = r.fallback_reason;
+    s.solver_message = r.message;
+    if (!r.fallback_reason.empty()) ++solver_fallbacks;
     return r.converged;
   }
 
@@ -370,6 +380,7 @@ ModelCounts Simulation::counts() const {
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
   c.cg_iterations_total = impl_->cg_iterations_total;
+  c.solver_fallbacks = impl_->solver_fallbacks;
   c.volume_initial = total_volume(impl_->initial.mesh);
   c.volume_final = total_volume(impl_->model->mesh());
   return c;
@@ -379,6 +390,7 @@ const StepStats& Simulation::last_stats() const { return impl_->last; }
 std::string Simulation::backend() const { return impl_->backend; }
 std::string Simulation::renderer() const { return impl_->renderer; }
 std::string Simulation::backend_note() const { return impl_->backend_note; }
+std::string Simulation::backend_requested() const { return impl_->requested_backend(); }
 std::vector<std::uint8_t> Simulation::tet_regions() const {
   return impl_->model->partition().operation_tet;
 }

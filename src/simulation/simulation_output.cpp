@@ -47,9 +47,15 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   j["cg_iterations_last_step"] = s.cg_iterations;
   j["residual"] = s.residual;
   j["converged"] = s.converged;
-  j["backend"] = backend();
+  if (!s.converged) j["solver_message"] = s.solver_message;
+  // What actually solved the final state (SPEC 4): a gl solve finished on the cpu says cpu.
+  const std::string solved_by = s.solved_by.empty() ? backend() : s.solved_by;
+  j["backend"] = solved_by;
+  j["backend_requested"] = backend_requested();
   if (backend() == "gl") j["renderer"] = renderer();
   if (!backend_note().empty()) j["backend_note"] = backend_note();
+  if (!s.fallback_reason.empty()) j["fallback_reason"] = s.fallback_reason;
+  j["solver_fallbacks"] = c.solver_fallbacks;
   j["steps"] = s.step;
   nlohmann::ordered_json t;
   for (const auto& [stage, ms] : precompute_timings_ms()) t["precompute_" + stage] = ms;

@@ -27,6 +27,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace stc {
@@ -35,6 +36,12 @@ namespace {
 // Relative diagonal shift of the second factorization attempt: far above the rounding of a
 // zero pivot (~1e-16 n), far below anything that would slow the preconditioned CG.
 constexpr double kShift = 1e-9;
+
+std::string format_residual(double r) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", r);
+  return buf;
+}
 
 class CpuCgSolver final : public LinearSolver {
  public:
@@ -61,6 +68,7 @@ class CpuCgSolver final : public LinearSolver {
                  const CgSettings& settings) override {
     const Eigen::Index n = a_.rows();
     CgResult result;
+    result.solved_by = "cpu";
     if (x.size() != n) x = Vector::Zero(n);
     Vector free_mask = Vector::Ones(n);
     if (!constrained.empty())
@@ -90,7 +98,10 @@ class CpuCgSolver final : public LinearSolver {
         result.converged = true;
         return result;
       }
-      if (result.iterations >= settings.max_iterations) return result;
+      if (result.iterations >= settings.max_iterations) {
+        result.message = iteration_cap_message(result, settings);
+        return result;
+      }
       Vector z = precondition(r);
       Vector p = z;
       double rz = r.dot(z);
@@ -117,6 +128,14 @@ class CpuCgSolver final : public LinearSolver {
           !(true_res < result.residual)) {
         result.residual = true_res;
         result.converged = true_res <= settings.tolerance;
+        if (!result.converged)
+          result.message = result.iterations >= settings.max_iterations
+                               ? iteration_cap_message(result, settings)
+                               : "CG stopped gaining at relative residual " +
+                                     format_residual(true_res) + " (tolerance " +
+                                     format_residual(settings.tolerance) +
+                                     "): too ill-conditioned for double precision, or not "
+                                     "positive definite on the free DOFs";
         return result;
       }
     }
@@ -155,6 +174,12 @@ class CpuCgSolver final : public LinearSolver {
 };
 
 }  // namespace
+
+std::string iteration_cap_message(const CgResult& result, const CgSettings& settings) {
+  return "max_iterations (" + std::to_string(settings.max_iterations) +
+         ") reached at relative residual " + format_residual(result.residual) + " (tolerance " +
+         format_residual(settings.tolerance) + ")";
+}
 
 std::unique_ptr<LinearSolver> make_cpu_solver(CgPreconditioner preconditioner) {
   return std::make_unique<CpuCgSolver>(preconditioner);

@@ -192,6 +192,53 @@ TEST(SolveCli, GlBackendAgreesWithCpu) {
   EXPECT_LT(err / ref, 1e-5);
 }
 
+TEST(SolveCli, NonConvergedFinalSolveExits3AfterWritingOutputs) {
+  // The liver on gl with max_iterations 3 cannot reach 1e-10 (Jacobi-scaled float CG): the
+  // run must say so (exit 3, one line on stderr) after writing both outputs.
+  const fs::path dir = fs::temp_directory_path() / "tissue_solve_cap";
+  fs::create_directories(dir);
+  const fs::path scene = dir / "capped.yaml";
+  const auto write_scene = [&](int max_iterations) {
+    std::ofstream(scene)
+        << "mesh: {file: " << kScenes << "../../test/data/sofa_liver.msh, scale: 0.02}\n"
+        << "material: {young_modulus: 3000.0, poisson_ratio: 0.3}\n"
+        << "fixed: [{nodes: [2, 38, 63]}]\n"
+        << "gravity: [0.0, -9.81, 0.0]\n"
+        << "operation_region: {sphere: {center: [-0.039, 0.065, 0.0143], radius: 0.03}}\n"
+        << "solver: {backend: gl, tolerance: 1.0e-10, max_iterations: " << max_iterations << "}\n";
+  };
+  write_scene(3);
+  fs::remove(dir / "o.vtk");
+  fs::remove(dir / "o.json");
+  const SolveRun r = run_solve(scene.string() + " --out " + (dir / "o.vtk").string() + " --stats " +
+                               (dir / "o.json").string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("did not converge"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("max_iterations (3)"), std::string::npos) << r.err;
+  ASSERT_TRUE(fs::exists(dir / "o.vtk"));
+  std::ifstream js(dir / "o.json");
+  ASSERT_TRUE(js.good());
+  const nlohmann::json j = nlohmann::json::parse(js);
+  EXPECT_EQ(j["converged"], false);
+  EXPECT_GT(j["residual"].get<double>(), 1e-10);
+  EXPECT_EQ(j["backend"], "gl");  // llvmpipe through EGL; the cap is no reason to fall back
+  EXPECT_EQ(j["backend_requested"], "gl");
+  EXPECT_FALSE(j.contains("fallback_reason"));
+  EXPECT_NE(j["solver_message"].get<std::string>().find("max_iterations"), std::string::npos);
+
+  // With room to converge: exit 0, converged on gl, nothing on stderr.
+  write_scene(2000);
+  const SolveRun ok = run_solve(scene.string() + " --stats " + (dir / "o.json").string());
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_TRUE(ok.err.empty()) << ok.err;
+  std::ifstream js2(dir / "o.json");
+  const nlohmann::json j2 = nlohmann::json::parse(js2);
+  EXPECT_EQ(j2["converged"], true);
+  EXPECT_EQ(j2["backend"], "gl");
+  EXPECT_LE(j2["residual"].get<double>(), 1e-10);
+}
+
 TEST(SolveCli, BadInputIsOneLineNamingTheFile) {
   const fs::path dir = fs::temp_directory_path() / "tissue_solve_bad";
   fs::create_directories(dir);

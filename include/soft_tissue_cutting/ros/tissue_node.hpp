@@ -118,7 +118,8 @@ class TissueNode {
   // Loop bookkeeping (loop thread; read by diagnostics under stats_mutex_).
   std::mutex stats_mutex_;
   double achieved_rate_ = 0;
-  bool last_converged_ = true;
+  bool last_converged_ = true;  // false: a solve since the last /diagnostics did not converge
+  std::string solver_failure_;  // its one-line reason
   std::uint64_t steps_ = 0;
 
   // Display bookkeeping (under sim_mutex_).

@@ -34,6 +34,12 @@ struct StepStats {
   int cg_iterations = 0;
   double residual = 0;
   bool converged = true;
+  // The backend that solved this step ("cpu" or "gl"; empty: nothing to solve). A gl solve
+  // that float32 could not finish is completed on the cpu: solved_by "cpu" and
+  // fallback_reason says why in one line.
+  std::string solved_by;
+  std::string fallback_reason;
+  std::string solver_message;  // one line when !converged: why the solve stopped short
   int tets_split = 0;   // this step
   int nodes_added = 0;  // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
@@ -47,6 +53,7 @@ struct ModelCounts {
   int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
   int cuts = 0, tets_split = 0, free_pieces_held = 0;
   long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
+  long solver_fallbacks = 0;     // gl solves finished on the cpu since the start (or reset)
   double volume_initial = 0, volume_final = 0;
 };
 
@@ -93,6 +100,7 @@ class Simulation {
   std::string backend() const;   // solver actually in use: "cpu" or "gl"
   std::string renderer() const;  // GL renderer for "gl"
   std::string backend_note() const;  // why gl fell back to cpu, if it did
+  std::string backend_requested() const;  // "cpu" or "gl": the option, else the scene's
   std::vector<std::uint8_t> tet_regions() const;  // 1 = operation part, per tet
   std::vector<BladePose> blade_path() const;       // poses of the current scalpel stroke
 

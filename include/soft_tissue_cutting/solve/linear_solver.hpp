@@ -23,10 +23,20 @@ struct CgSettings {
 };
 
 struct CgResult {
-  int iterations = 0;
+  int iterations = 0;   // every CG iteration of this solve, fallback included
   double residual = 0;  // final relative residual ||b - A x|| / ||b|| (true residual)
   bool converged = false;
+  // The backend that produced x: "cpu" or "gl". A gl solve that float32 could not finish is
+  // completed by the CPU solver: then solved_by is "cpu" and fallback_reason says why (one
+  // line). Empty solved_by: nothing was solved (no free DOFs).
+  std::string solved_by;
+  std::string fallback_reason;
+  // One line when !converged: why the solve stopped short of the tolerance.
+  std::string message;
 };
+
+// The one-line reason of a solve that used up max_iterations (both backends).
+std::string iteration_cap_message(const CgResult& result, const CgSettings& settings);
 
 // Solves A x = b with some DOFs held at the values x already has on entry (Dirichlet:
 // contact-imposed displacements, held free pieces): those DOFs have constrained[i] != 0 and
