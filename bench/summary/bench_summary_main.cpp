@@ -33,11 +33,13 @@ int usage(const char* why) {
 
 std::vector<stc::BenchCase> all_cases() {
   const std::string scenes = std::string(TISSUE_SOURCE_DIR) + "/config/scenes/";
+  const std::string bench_scenes = std::string(TISSUE_SOURCE_DIR) + "/bench/scenes/";
   return {
       {"thigh1", [] { return stc::make_thigh_scene(1.0); }},
       {"thigh2", [] { return stc::make_thigh_scene(2.0); }},
       {"liver_organ", [scenes] { return stc::load_scene(scenes + "liver_organ.yaml"); }},
-      {"liver_200k", [scenes] { return stc::load_scene(scenes + "liver_organ_200k.yaml"); }},
+      {"liver_200k",
+       [bench_scenes] { return stc::load_scene(bench_scenes + "liver_organ_200k.yaml"); }},
   };
 }
 
