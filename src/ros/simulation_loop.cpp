@@ -17,8 +17,8 @@ void TissueNode::loop() {
     bool converged = true;
     {
       std::lock_guard<std::mutex> lock(sim_mutex_);
-      // A ~cut slice first (at most ~40 % of the period, at least one sweep), then the step
-      // that solves on the cut mesh.
+      // A ~cut slice first (up to ~40 % of the period, at least one sweep; see
+      // advance_cut_locked), then the step that solves on the cut mesh.
       advance_cut_locked(t0 + period * 2 / 5);
       std::optional<BladePose> blade = current_blade();
       if (blade) blade->t = static_cast<double>(steps_) / params_.rate;
@@ -59,7 +59,15 @@ void TissueNode::advance_cut_locked(LoopMonitor::Clock::time_point deadline) {
     job.poses.clear();
     job.poses.shrink_to_fit();
   }
-  if (!job.path.done()) sim_->cut_path_slice(job.path, deadline);
+  if (job.path.done()) return;
+  // One sweep cannot be split (tens of ms on the thigh), so slices are also spaced out: after
+  // a slice of d, the loop steps without cutting for 1.5 d, so the cut takes at most ~40 % of
+  // the loop's time and the steps in between keep their rate.
+  const auto now = LoopMonitor::Clock::now();
+  if (now < next_cut_slice_) return;
+  sim_->cut_path_slice(job.path, deadline);
+  const auto end = LoopMonitor::Clock::now();
+  next_cut_slice_ = end + (end - now) * 3 / 2;
 }
 
 void TissueNode::finish_cut_locked(const StepStats& step) {

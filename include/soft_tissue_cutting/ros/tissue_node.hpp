@@ -139,6 +139,7 @@ class TissueNode {
   std::deque<std::shared_ptr<CutJob>> queued_cuts_;
   int cuts_waiting_ = 0;  // service calls waiting for their cut (queued or in progress)
   std::shared_ptr<CutJob> active_cut_;  // under sim_mutex_
+  LoopMonitor::Clock::time_point next_cut_slice_{};  // under sim_mutex_
 
   // What /diagnostics says about the backend: copied under sim_mutex_, read under info_mutex_.
   std::mutex info_mutex_;
