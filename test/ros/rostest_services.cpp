@@ -201,7 +201,14 @@ TEST_F(Fixture, RepeatedCutGivesTheTrueReason) {
   cut.request.poses = stroke();
   ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
   ASSERT_TRUE(cut.response.success) << cut.response.message;
-  ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+  // Again: a pass or two may still open faces where the first one snapped; then the reply
+  // names the true reason (not "does not cross the operation part").
+  int passes = 0;
+  do {
+    ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+    ++passes;
+  } while (cut.response.success && passes < 5);
+  EXPECT_LE(passes, 3);
   EXPECT_FALSE(cut.response.success);
   EXPECT_NE(cut.response.message.find("already cut"), std::string::npos) << cut.response.message;
 }

@@ -75,8 +75,9 @@ int run_random_strokes(Simulation& sim, RandomStrokes& random, int strokes, cons
     const SparseMatrix& a_full = sim.model().hybrid_matrix();
     EXPECT_LT((SparseMatrix(a_full.transpose()) - a_full).norm(), 1e-12 * a_full.norm())
         << "sweep " << k;
-    if (k % spd_every == 0 || k + 1 == strokes)
+    if (k % spd_every == 0 || k + 1 == strokes) {
       EXPECT_NO_THROW(SparseCholesky{free_block(sim)}) << "sweep " << k << ": not SPD";
+    }
     EXPECT_TRUE(sim.model().last_result().converged) << "sweep " << k;
     EXPECT_TRUE(sim.model().displacement().allFinite()) << "sweep " << k;
     if (::testing::Test::HasFailure()) return cuts;
