@@ -3,6 +3,7 @@
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
+#include "soft_tissue_cutting/cutting/blade_path.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
@@ -11,6 +12,7 @@
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
@@ -36,6 +38,20 @@ bool inside_rest_tissue(const TetMesh& mesh, const CutState& state, const Vec3& 
       return true;
   }
   return false;
+}
+
+// Median edge length of the operation part's tets (0 if it has none).
+double median_operation_edge(const TetMesh& mesh, const std::vector<std::uint8_t>& operation) {
+  std::vector<double> edges;
+  for (size_t t = 0; t < mesh.tets.size(); ++t) {
+    if (t >= operation.size() || !operation[t]) continue;
+    const Tet& k = mesh.tets[t];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) edges.push_back((mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
+  }
+  if (edges.empty()) return 0;
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+  return edges[edges.size() / 2];
 }
 
 }  // namespace
@@ -72,6 +88,10 @@ struct Simulation::Impl {
     return options.backend.empty() ? scene.solver.backend : options.backend;
   }
 
+  // ~cut paths are resampled at this spacing (docs/DESIGN.md (cutting)): the median edge of
+  // the initial operation part, so one sweep per element size whatever the caller's sampling.
+  double cut_spacing = 0;
+
   std::unique_ptr<LinearSolver> make_solver() {
     const std::string wanted = requested_backend();
     backend = "cpu";
@@ -100,6 +120,7 @@ struct Simulation::Impl {
     std::vector<std::uint8_t> locked(static_cast<size_t>(model->mesh().num_nodes()), 0);
     for (int i : p.interface) locked[static_cast<size_t>(i)] = 1;
     cut_state = make_cut_state(model->mesh_for_cutting(), locked, p.operation_tet);
+    cut_spacing = median_operation_edge(scene.mesh, p.operation_tet);
     anchored = model->fixed_nodes();
     for (int i : p.interface) anchored[static_cast<size_t>(i)] = 1;
     held.clear();
@@ -312,33 +333,85 @@ StepStats Simulation::step(const std::optional<BladePose>& blade) {
 const StepTimes& Simulation::step_times() const { return impl_->step_times; }
 
 CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
-  CutOutcome out;
+  PathCut path = begin_path_cut(poses);
+  while (!path.done()) cut_path_slice(path, Clock::time_point::max());
+  CutOutcome out = finish_path_cut(path);
+  if (!path.refusal.empty()) return out;
+  StepStats s;
+  if (!impl_->solve({}, s)) out.message += "; warning: the solver did not converge";
+  ++impl_->surface_version;
+  return out;
+}
+
+PathCut Simulation::begin_path_cut(const std::vector<BladePose>& poses) const {
+  PathCut cut;
   if (poses.size() < 2) {
-    out.message = "need at least two blade poses to sweep a cut";
-    return out;
+    cut.refusal = "need at least two blade poses to sweep a cut";
+    return cut;
   }
   for (size_t i = 0; i < poses.size(); ++i)
     if (!finite_pose(poses[i])) {
-      out.message = "pose " + std::to_string(i) + " is not finite";
-      return out;
+      cut.refusal = "pose " + std::to_string(i) + " is not finite (NaN/Inf) or a zero quaternion";
+      return cut;
     }
-  const int faces_before = impl_->cut_face_count();
-  StepStats s;
-  for (size_t i = 1; i < poses.size(); ++i) impl_->cut(poses[i - 1], poses[i], s);
-  s.converged = impl_->solve({}, s);
-  ++impl_->surface_version;
-  const int faces_after = impl_->cut_face_count();
-  out.tets_split = s.tets_split;
-  out.nodes_added = s.nodes_added;
-  out.cut_faces = faces_after - faces_before;
-  out.success = s.cutting;
-  out.message = s.cutting ? "cut inserted" : "the blade path does not cross the operation part";
-  if (s.reached_interface) out.message += "; stopped at the interface of the condensed part";
-  if (!s.converged) out.message += "; warning: the solver did not converge";
+  cut.poses = resample_blade_path(poses, impl_->scene.scalpel.blade_length, impl_->cut_spacing);
+  cut.faces_before = impl_->cut_face_count();
+  return cut;
+}
+
+void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
+  const double length = impl_->scene.scalpel.blade_length;
+  bool changed = false;
+  do {
+    if (cut.done()) break;
+    const BladePose& from = cut.poses[cut.next - 1];
+    const BladePose& to = cut.poses[cut.next];
+    // Does the blade edge lie in the operation part here? (Tells "already cut" from "missed".)
+    if (!cut.crossed) {
+      const BladeEdge e = blade_edge(from, length);
+      for (const Vec3& x : {e.tip, Vec3(0.5 * (e.tip + e.heel)), e.heel})
+        cut.crossed = cut.crossed || tip_inside_tissue(mesh(), impl_->cut_state, x);
+    }
+    StepStats s;
+    changed |= impl_->cut(from, to, s);
+    cut.tets_split += s.tets_split;
+    cut.nodes_added += s.nodes_added;
+    cut.reached_interface |= s.reached_interface;
+    ++cut.next;
+  } while (Clock::now() < deadline);
+  if (changed) {
+    cut.changed = true;
+    ++impl_->surface_version;
+  }
+}
+
+CutOutcome Simulation::finish_path_cut(const PathCut& cut) const {
+  CutOutcome out;
+  if (!cut.refusal.empty()) {
+    out.message = cut.refusal;
+    return out;
+  }
+  out.tets_split = cut.tets_split;
+  out.nodes_added = cut.nodes_added;
+  out.cut_faces = impl_->cut_face_count() - cut.faces_before;
+  out.success = cut.changed;
+  if (cut.changed)
+    out.message = "cut inserted";
+  else if (cut.crossed)
+    out.message = "the blade path runs through the operation part only where it is already cut: "
+                  "no new cut faces";
+  else if (cut.reached_interface)
+    out.message = "the blade path only reaches the interface of the condensed part, which is not "
+                  "cut";
+  else
+    out.message = "the blade path does not cross the operation part";
+  if (cut.changed && cut.reached_interface)
+    out.message += "; stopped at the interface of the condensed part";
   return out;
 }
 
 void Simulation::reset() { impl_->start(); }
+double Simulation::cut_path_spacing() const { return impl_->cut_spacing; }
 void Simulation::set_cutting_enabled(bool enabled) { impl_->cutting_enabled = enabled; }
 bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }

@@ -6,6 +6,7 @@
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -26,7 +27,7 @@ struct SimulationOptions {
 struct StepStats {
   std::uint64_t step = 0;
   bool in_contact = false;
-  bool cutting = false;          // this step inserted a cut
+  bool cutting = false;               // this step inserted a cut
   Vec3 contact_force = Vec3::Zero();  // N, reaction of the tissue on the blade (scene frame)
   Vec3 contact_torque = Vec3::Zero();  // N m, its moment about the blade tip (scene frame)
   std::vector<int> contact_nodes;      // the nodes the blade holds this step, ascending
@@ -63,11 +64,26 @@ struct CutOutcome {
   int tets_split = 0, nodes_added = 0, cut_faces = 0;
 };
 
+// A cut path being inserted a slice at a time (begin_path_cut, cut_path_slice,
+// finish_path_cut), so a caller can keep stepping between the slices of a long path; the ROS
+// node does, and cut_along() is the three in one go plus a solve.
+struct PathCut {
+  std::string refusal;           // set: the path was refused (done() at once)
+  std::vector<BladePose> poses;  // the path resampled at a fixed spacing (cutting/blade_path)
+  std::size_t next = 1;          // the next sweep is poses[next - 1] -> poses[next]
+  int faces_before = 0;
+  int tets_split = 0, nodes_added = 0;
+  bool changed = false;            // some sweep changed the mesh
+  bool crossed = false;            // some pose of the blade edge lay in the operation part
+  bool reached_interface = false;  // cut faces dropped at the interface of the condensed part
+  bool done() const { return !refusal.empty() || next >= poses.size(); }
+};
+
 // The visible deformed surface: operation-part surface including cut faces, plus the
 // condensed surface S (docs/DESIGN.md eq. (12)).
 struct DeformedSurface {
-  std::vector<Vec3> positions;        // deformed position of every mesh node
-  std::vector<double> displacement;   // |u| per node, m
+  std::vector<Vec3> positions;       // deformed position of every mesh node
+  std::vector<double> displacement;  // |u| per node, m
   std::vector<BoundaryTriangle> triangles;
 };
 
@@ -82,6 +98,17 @@ class Simulation {
   StepStats step(const std::optional<BladePose>& blade);
   // Cut along consecutive poses regardless of cut_pressure (the ~cut service), then solve.
   CutOutcome cut_along(const std::vector<BladePose>& poses);
+  // Validates (>= 2 finite poses) and resamples the path; a refused path comes back done()
+  // with `refusal` set.
+  PathCut begin_path_cut(const std::vector<BladePose>& poses) const;
+  // Inserts the next sweeps of `cut` until `deadline` (at least one); no solve, so the next
+  // step() (or cut_along's solve) brings the displacements to the new mesh.
+  void cut_path_slice(PathCut& cut, std::chrono::steady_clock::time_point deadline);
+  // Counts of the finished (or refused) cut and the true reason when nothing was cut.
+  CutOutcome finish_path_cut(const PathCut& cut) const;
+  // Spacing (m) at which cut paths are resampled: the median edge of the initial operation
+  // part.
+  double cut_path_spacing() const;
   // Back to the initial mesh and state, identical to a fresh start.
   void reset();
 
@@ -102,7 +129,7 @@ class Simulation {
   std::string backend_note() const;  // why gl fell back to cpu, if it did
   std::string backend_requested() const;  // "cpu" or "gl": the option, else the scene's
   std::vector<std::uint8_t> tet_regions() const;  // 1 = operation part, per tet
-  std::vector<BladePose> blade_path() const;       // poses of the current scalpel stroke
+  std::vector<BladePose> blade_path() const;      // poses of the current scalpel stroke
 
   // Full displacement (3 x nodes), interior condensed nodes recovered (for output).
   Eigen::VectorXd full_displacement();
