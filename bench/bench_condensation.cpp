@@ -54,7 +54,9 @@ const Scene& thigh(int region = 0) {
   static const Scene coarse = make_small_region_thigh();
   return region == 0 ? refined : coarse;
 }
-const Scene& thigh(const benchmark::State& state) { return thigh(static_cast<int>(state.range(1))); }
+const Scene& thigh(const benchmark::State& state) {
+  return thigh(static_cast<int>(state.range(1)));
+}
 int contact_node(const benchmark::State& state) { return thigh(state).loads[0].where.nodes[0]; }
 
 CgPreconditioner preconditioner(const benchmark::State& state) {
@@ -165,10 +167,16 @@ void BM_Table1_GeneralFactor(benchmark::State& state) {
 }
 
 // precond 0: Jacobi, 1: Cholesky; region 0: built-in thigh, 1: small (paper-like) region.
-#define STC_TABLE1(fn)                                                                   \
-  BENCHMARK(fn)->ArgNames({"precond", "region"})->ArgsProduct({{0, 1}, {0, 1}})          \
-      ->Unit(benchmark::kMillisecond)->Repetitions(15)->ReportAggregatesOnly(true)
-BENCHMARK(BM_Precompute)->Unit(benchmark::kMillisecond)->Repetitions(15)
+#define STC_TABLE1(fn)                  \
+  BENCHMARK(fn)                         \
+      ->ArgNames({"precond", "region"}) \
+      ->ArgsProduct({{0, 1}, {0, 1}})   \
+      ->Unit(benchmark::kMillisecond)   \
+      ->Repetitions(15)                 \
+      ->ReportAggregatesOnly(true)
+BENCHMARK(BM_Precompute)
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(15)
     ->ReportAggregatesOnly(true);
 STC_TABLE1(BM_Table1_CondensedStep_Cold);
 STC_TABLE1(BM_Table1_GeneralStep_Cold);

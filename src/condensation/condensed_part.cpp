@@ -36,7 +36,7 @@ CondensedPart condense_non_operation_part(const TetMesh& mesh,
   // N ordered S first, then Q: the surface DOFs are then the head of u_N.
   c.condensed_dofs = make_dof_map(n, concat(partition.surface, partition.interior), fixed_node);
   const auto& part2 = partition.condensed_tets;
-  // K^(2) blocks from part-2 tets only (METHOD 2).
+  // K^(2) blocks from part-2 tets only (docs/DESIGN.md section 3).
   const SparseMatrix k_ii =
       assemble_block(mesh, elements, part2, c.interface_dofs, c.interface_dofs);
   const SparseMatrix k_nn =

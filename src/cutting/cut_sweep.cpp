@@ -86,7 +86,8 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
   const std::vector<std::array<Vec3, 3>> sweep = {{from.tip, from.heel, to.heel},
                                                   {from.tip, to.heel, to.tip}};
   const std::vector<std::array<Vec3, 3>> none;
-  CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
+  CutResult result =
+      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
   // The stroke so far: every non-degenerate sweep triangle since the blade began this
   // continuous cut, so that faces spanning many small sweeps (a blade moving 1 mm per step
   // through 6 mm tets) are still opened. Bounded so a very long stroke stays cheap.

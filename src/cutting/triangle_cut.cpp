@@ -101,7 +101,8 @@ void TriangleClassification::bounds(Vec3& lo, Vec3& hi) const {
   hi = a_.cwiseMax(b_).cwiseMax(c_) + pad;
 }
 
-std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet, int face) {
+std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet,
+                                     int face) {
   const Tet& t = mesh.tets[tet];
   const int p = t[kTetFaces[face][0]], q = t[kTetFaces[face][1]], r = t[kTetFaces[face][2]];
   for (int other : state.node_tets[p]) {
@@ -143,7 +144,8 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         if (state.locked[u] && state.locked[v]) continue;  // interface edges stay whole
         const double du = tri.distance(mesh, u), dv = tri.distance(mesh, v);
         const double s = du / (du - dv);
-        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), options.inside_tolerance))
+        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
+                          options.inside_tolerance))
           continue;
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
@@ -219,7 +221,8 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
       if (tri.side(mesh, state, mesh.tets[other][other_face]) != -here) continue;
-      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0, options.inside_tolerance))
+      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0,
+                        options.inside_tolerance))
         continue;
       if (!state.cuttable[other]) {  // the blade stops at the condensed part
         result.reached_interface = true;

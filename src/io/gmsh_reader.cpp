@@ -279,8 +279,8 @@ class GmshReader {
 
   // Gmsh 4.1 $Nodes / $Elements header: numBlocks numItems minTag maxTag (four size_t in
   // binary). `min_bytes_per_item` bounds the ASCII item count by the file size.
-  void read_v4_section_header(const std::string& what, int min_bytes_per_item,
-                              long long& blocks, long long& total) {
+  void read_v4_section_header(const std::string& what, int min_bytes_per_item, long long& blocks,
+                              long long& total) {
     if (binary_) {
       c_.skip_past_newline();
       const std::string header = what + " section header";

@@ -26,12 +26,19 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
     for (int n : mesh.tets[static_cast<size_t>(t)]) used[static_cast<size_t>(n)] |= op ? 1 : 2;
   }
   std::vector<std::uint8_t> on_boundary(static_cast<size_t>(mesh.num_nodes()), 0);
-  for (int n : boundary_nodes(extract_boundary_surface(mesh))) on_boundary[static_cast<size_t>(n)] = 1;
+  for (int n : boundary_nodes(extract_boundary_surface(mesh)))
+    on_boundary[static_cast<size_t>(n)] = 1;
   p.node_set.assign(static_cast<size_t>(mesh.num_nodes()), NodeSet::kUnused);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
     switch (used[static_cast<size_t>(n)]) {
-      case 1: p.node_set[n] = NodeSet::kOperation; p.operation.push_back(n); break;
-      case 3: p.node_set[n] = NodeSet::kInterface; p.interface.push_back(n); break;
+      case 1:
+        p.node_set[n] = NodeSet::kOperation;
+        p.operation.push_back(n);
+        break;
+      case 3:
+        p.node_set[n] = NodeSet::kInterface;
+        p.interface.push_back(n);
+        break;
       case 2:
         if (on_boundary[static_cast<size_t>(n)]) {
           p.node_set[n] = NodeSet::kSurface;
@@ -41,14 +48,15 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
           p.interior.push_back(n);
         }
         break;
-      default: break;
+      default:
+        break;
     }
   }
   return p;
 }
 
-bool update_partition_for_operation_change(const TetMesh& mesh, const std::vector<int>& changed_tets,
-                                           Partition& p) {
+bool update_partition_for_operation_change(const TetMesh& mesh,
+                                           const std::vector<int>& changed_tets, Partition& p) {
   const size_t old_tets = p.operation_tet.size();
   for (int t : changed_tets)
     if (t >= 0 && static_cast<size_t>(t) < old_tets && !p.operation_tet[static_cast<size_t>(t)])

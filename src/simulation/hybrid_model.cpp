@@ -34,14 +34,13 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   elements_ = ElementStiffnessCache(mesh_, scene.material);
   timings_["element_stiffness"] = ms_since(t0);
 
-  // K0, g0 (METHOD 3). Loads on interface nodes stay with part 1 (they enter f_I below), so
-  // only f_N reaches the condensation.
+  // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
+  // below), so only f_N reaches the condensation.
   condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
   timings_["condensation_assembly"] = condensed_.assembly_ms;
   timings_["condensation_factor"] = condensed_.factor_ms;
   timings_["condensation_solve"] = condensed_.solve_ms;
   timings_["condensation_products"] = condensed_.product_ms;
-
 
   u_ = Vector::Zero(3 * mesh_.num_nodes());
   t0 = Clock::now();
@@ -86,7 +85,8 @@ void HybridModel::rebuild_hybrid_system() {
 
   // Right-hand side: f_O, f_I - g0.
   b_ = gather(loads(), dofs_);
-  for (int k = 0; k < idofs.rows(); ++k) b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
+  for (int k = 0; k < idofs.rows(); ++k)
+    b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
   solver_->set_matrix(a_);
   system_changed_ = true;
 }
@@ -133,8 +133,8 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
 
 const Vector& HybridModel::displacement() const {
   if (!condensed_stale_) return u_;
-  // u_N = K2_NN^-1 (f_N - K2_NI u_I) (METHOD 4) through the kept factor: S and Q at once,
-  // exact to the factorization's rounding, no dense 3|S| x 3|I| operator in memory.
+  // u_N = K2_NN^-1 (f_N - K2_NI u_I) (docs/DESIGN.md eq. (13)) through the kept factor: S and Q at
+  // once, exact to the factorization's rounding, no dense 3|S| x 3|I| operator in memory.
   recovered_from_ = gather(u_, condensed_.interface_dofs);
   if (condensed_.condensed_dofs.rows() > 0)
     scatter(recover_condensed(condensed_, recovered_from_, condensed_scale_),
@@ -173,8 +173,9 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   const int old_nodes = static_cast<int>(u_.size() / 3);
   const int n = mesh_.num_nodes();
   if (n - old_nodes != static_cast<int>(new_nodes.size()))
-    throw std::invalid_argument("HybridModel::update_operation_part: new_nodes does not match "
-                                "the nodes appended to the mesh");
+    throw std::invalid_argument(
+        "HybridModel::update_operation_part: new_nodes does not match "
+        "the nodes appended to the mesh");
   // New nodes: displacement interpolated from their parents (cut_result.hpp), unloaded.
   u_.conservativeResize(3 * n);
   point_loads_.conservativeResize(3 * n);
@@ -186,8 +187,10 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     if (nn.a < 0 || nn.a >= node || (split && (nn.b < 0 || nn.b >= node)))
       throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
     if (split) {
-      u_.segment<3>(3 * node) = (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
-      fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
+      u_.segment<3>(3 * node) =
+          (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
+      fixed_[static_cast<size_t>(node)] =
+          fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
     } else {
       u_.segment<3>(3 * node) = u_.segment<3>(3 * nn.a);
       fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)];
@@ -200,8 +203,9 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   // part must be untouched: same I, S, Q and part-2 tets.
   Partition p = partition_;
   if (!update_partition_for_operation_change(mesh_, changed_tets, p))
-    throw std::logic_error("HybridModel::update_operation_part: the change reached the "
-                           "condensed (non-operation) part");
+    throw std::logic_error(
+        "HybridModel::update_operation_part: the change reached the "
+        "condensed (non-operation) part");
   partition_ = std::move(p);
   rebuild_hybrid_system();
 }
@@ -210,9 +214,9 @@ void HybridModel::set_young_modulus(double young_modulus) {
   if (!(young_modulus > 0)) throw std::invalid_argument("young_modulus must be > 0");
   const double s = young_modulus / elements_.material().young_modulus;
   elements_.set_young_modulus(young_modulus);
-  condensed_.K0 *= s;        // K2 scales with E
+  condensed_.K0 *= s;  // K2 scales with E
   k0_padded_ *= s;
-  condensed_scale_ *= s;     // u_N recovery: K2_NN^-1 f_N scales with 1/E; g0 is a ratio
+  condensed_scale_ *= s;  // u_N recovery: K2_NN^-1 f_N scales with 1/E; g0 is a ratio
   condensed_stale_ = true;
   rebuild_hybrid_system();
 }

@@ -57,8 +57,8 @@ double median_operation_edge(const TetMesh& mesh, const std::vector<std::uint8_t
 }  // namespace
 
 struct Simulation::Impl {
-  Scene initial;   // as loaded: reset() returns here
-  Scene scene;     // live parameters (cut pressure, E)
+  Scene initial;  // as loaded: reset() returns here
+  Scene scene;    // live parameters (cut pressure, E)
   SimulationOptions options;
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
@@ -66,7 +66,7 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
-  OperationSurface boundary;  // the boundary after cuts from part 1 alone
+  OperationSurface boundary;           // the boundary after cuts from part 1 alone
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -152,8 +152,7 @@ struct Simulation::Impl {
     if (!floating.empty())
       throw std::invalid_argument(
           scene.source + ": the mesh has " + std::to_string(floating.size()) +
-          " piece(s) with no fixed node (the first has " +
-          std::to_string(floating[0].tets.size()) +
+          " piece(s) with no fixed node (the first has " + std::to_string(floating[0].tets.size()) +
           " tets): fix at least one node of every piece");
   }
 
@@ -270,9 +269,8 @@ struct Simulation::Impl {
         surface_tree.refit(model->mesh(), displacements());
         std::optional<BladeEdge> previous;
         if (last_pose) previous = blade_edge(*last_pose, length);
-        imposed =
-            contact.update(surface_tree, model->mesh(), model->operation_displacement(), previous,
-                           edge);
+        imposed = contact.update(surface_tree, model->mesh(), model->operation_displacement(),
+                                 previous, edge);
         blade_state = contact.empty() ? BladeState::kFree : BladeState::kPressing;
       }
       s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
@@ -398,11 +396,13 @@ CutOutcome Simulation::finish_path_cut(const PathCut& cut) const {
   if (cut.changed)
     out.message = "cut inserted";
   else if (cut.crossed)
-    out.message = "the blade path runs through the operation part only where it is already cut: "
-                  "no new cut faces";
+    out.message =
+        "the blade path runs through the operation part only where it is already cut: "
+        "no new cut faces";
   else if (cut.reached_interface)
-    out.message = "the blade path only reaches the interface of the condensed part, which is not "
-                  "cut";
+    out.message =
+        "the blade path only reaches the interface of the condensed part, which is not "
+        "cut";
   else
     out.message = "the blade path does not cross the operation part";
   if (cut.changed && cut.reached_interface)

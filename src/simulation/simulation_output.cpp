@@ -48,7 +48,8 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   j["residual"] = s.residual;
   j["converged"] = s.converged;
   if (!s.converged) j["solver_message"] = s.solver_message;
-  // What actually solved the final state (SPEC 4): a gl solve finished on the cpu says cpu.
+  // What actually solved the final state (docs/SCENE.md "Offline run"): a gl solve finished on the
+  // cpu says cpu.
   const std::string solved_by = s.solved_by.empty() ? backend() : s.solved_by;
   j["backend"] = solved_by;
   j["backend_requested"] = backend_requested();

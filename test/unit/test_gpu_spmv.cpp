@@ -54,10 +54,12 @@ TEST_P(GpuSpmv, ElasticityLikePoisson3D) {
   const double err = spmv_error(a, &passes);
   RecordProperty("relative_error", std::to_string(err));
   std::printf("[%s] 3D elasticity-like N=%d: rel err %.3g, %d passes (%s, %s, %s)\n",
-              layout_name(GetParam()).c_str(), int(a.rows()), err, passes,
-              ctx_->renderer().c_str(), ctx_->version().c_str(), ctx_->origin().c_str());
+              layout_name(GetParam()).c_str(), int(a.rows()), err, passes, ctx_->renderer().c_str(),
+              ctx_->version().c_str(), ctx_->origin().c_str());
   EXPECT_LE(err, 1e-6);
-  EXPECT_EQ(passes, GetParam() == SpmvLayout::MethodA ? 20 : GetParam() == SpmvLayout::MethodB ? 5 : 1);
+  EXPECT_EQ(passes, GetParam() == SpmvLayout::MethodA   ? 20
+                    : GetParam() == SpmvLayout::MethodB ? 5
+                                                        : 1);
 }
 
 TEST_P(GpuSpmv, DenseInterfaceBlock) {
@@ -83,8 +85,11 @@ TEST_P(GpuSpmv, Table2MatrixHasStatedMaxRow) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, GpuSpmv,
-                         ::testing::Values(SpmvLayout::MethodA, SpmvLayout::MethodB, SpmvLayout::RowLoop),
-                         [](const ::testing::TestParamInfo<SpmvLayout>& i) { return layout_name(i.param); });
+                         ::testing::Values(SpmvLayout::MethodA, SpmvLayout::MethodB,
+                                           SpmvLayout::RowLoop),
+                         [](const ::testing::TestParamInfo<SpmvLayout>& i) {
+                           return layout_name(i.param);
+                         });
 
 }  // namespace
 }  // namespace gpu

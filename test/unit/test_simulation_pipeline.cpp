@@ -189,7 +189,8 @@ TEST(SimulationPipeline, RefusesBadInput) {
 // moves, the mean tip deflection is the linear-tet figure 2.016e-4 m (Euler-Bernoulli: 2.5e-4 m);
 // its trajectory then presses into the top face, yields and cuts a slit across the bar.
 TEST(SimulationPipeline, CantileverExampleMatchesReferenceThenCuts) {
-  const Scene scene = load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/cantilever.yaml");
+  const Scene scene =
+      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/cantilever.yaml");
   Simulation sim(scene);
   double tip = 0;
   int n = 0;
@@ -261,7 +262,8 @@ TEST(SimulationPipeline, StraightCutThroughBlockOpens) {
   // Nodes duplicated along the cut share a rest position; the two sides now move apart.
   std::map<std::array<double, 3>, std::vector<int>> at;
   const TetMesh& m = sim.mesh();
-  for (int i = 0; i < m.num_nodes(); ++i) at[{m.nodes[i].x(), m.nodes[i].y(), m.nodes[i].z()}].push_back(i);
+  for (int i = 0; i < m.num_nodes(); ++i)
+    at[{m.nodes[i].x(), m.nodes[i].y(), m.nodes[i].z()}].push_back(i);
   const Vector& u = sim.model().displacement();
   double opening = 0, umax = 0;
   for (const auto& [x, nodes] : at)

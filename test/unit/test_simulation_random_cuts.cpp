@@ -60,9 +60,9 @@ struct RandomStrokes {
   }
 };
 
-// Cuts `strokes` random strokes and checks SPEC 6, symmetry and the solve after every one, and
-// positive definiteness (a sparse Cholesky of the free block) after every `spd_every`-th and
-// the last; returns how many cut.
+// Cuts `strokes` random strokes and checks the cut invariants (docs/SCENE.md "Cut invariants"),
+// symmetry and the solve after every one, and positive definiteness (a sparse Cholesky of the free
+// block) after every `spd_every`-th and the last; returns how many cut.
 int run_random_strokes(Simulation& sim, RandomStrokes& random, int strokes, const Vec3& centre,
                        double spread, double length, double bias, int spd_every = 1) {
   int cuts = 0;

@@ -31,7 +31,8 @@ struct SolveRun {
 
 SolveRun run_solve(const std::string& args) {
   const fs::path err = fs::temp_directory_path() / "tissue_solve_stderr.txt";
-  const std::string cmd = std::string(TISSUE_SOLVE_BIN) + " " + args + " 2>" + err.string() + " >/dev/null";
+  const std::string cmd =
+      std::string(TISSUE_SOLVE_BIN) + " " + args + " 2>" + err.string() + " >/dev/null";
   const int status = std::system(cmd.c_str());
   std::ifstream in(err);
   std::stringstream ss;
@@ -92,13 +93,14 @@ TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
   fs::create_directories(dir);
   const std::string scene_file = kScenes + "liver.yaml";
   const SolveRun r = run_solve(scene_file + " --out " + (dir / "o.vtk").string() + " --stats " +
-                          (dir / "o.json").string());
+                               (dir / "o.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Vtk v = read_output(dir / "o.vtk");
   const Scene scene = load_scene(scene_file);
   ASSERT_EQ(v.points.size(), scene.mesh.nodes.size());
   ASSERT_EQ(v.cells.size(), scene.mesh.tets.size());
-  for (size_t i = 0; i < v.points.size(); ++i) ASSERT_EQ(v.points[i], scene.mesh.nodes[i]);  // %.17g
+  for (size_t i = 0; i < v.points.size(); ++i)
+    ASSERT_EQ(v.points[i], scene.mesh.nodes[i]);  // %.17g
   int operation = 0;
   for (int x : v.region) operation += x;
   EXPECT_GT(operation, 0);
@@ -118,10 +120,10 @@ TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
 
   std::ifstream js(dir / "o.json");
   const nlohmann::json j = nlohmann::json::parse(js);
-  for (const char* key : {"nodes", "tets", "dof_operation", "nodes_interface",
-                          "nodes_surface_condensed", "nodes_interior_condensed", "cuts",
-                          "tets_split", "volume_initial", "volume_final", "cg_iterations",
-                          "residual", "backend", "timings_ms"})
+  for (const char* key :
+       {"nodes", "tets", "dof_operation", "nodes_interface", "nodes_surface_condensed",
+        "nodes_interior_condensed", "cuts", "tets_split", "volume_initial", "volume_final",
+        "cg_iterations", "residual", "backend", "timings_ms"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["nodes"], scene.mesh.num_nodes());
   EXPECT_EQ(j["tets"], scene.mesh.num_tets());
@@ -136,7 +138,7 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
   const fs::path dir = fs::temp_directory_path() / "tissue_solve_thigh";
   fs::create_directories(dir);
   const SolveRun r = run_solve("thigh --out " + (dir / "o.vtk").string() + " --stats " +
-                          (dir / "o.json").string());
+                               (dir / "o.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream js(dir / "o.json");
   const nlohmann::json j = nlohmann::json::parse(js);
@@ -144,7 +146,8 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
   EXPECT_GT(j["tets_split"].get<int>(), 0);
   EXPECT_NEAR(j["volume_final"].get<double>(), j["volume_initial"].get<double>(),
               1e-9 * j["volume_initial"].get<double>());
-  // step_ms (SPEC 4): the trajectory's steps by kind; every cut was inserted by one step.
+  // step_ms (docs/SCENE.md "Offline run"): the trajectory's steps by kind; every cut was inserted
+  // by one step.
   ASSERT_TRUE(j.contains("step_ms"));
   int steps = 0;
   for (const char* kind : {"idle", "pressing", "cutting"}) {
@@ -175,9 +178,10 @@ TEST(SolveCli, GlBackendAgreesWithCpu) {
   const fs::path dir = fs::temp_directory_path() / "tissue_solve_gl";
   fs::create_directories(dir);
   const std::string scene_file = kScenes + "liver.yaml";
-  ASSERT_EQ(run_solve(scene_file + " --backend cpu --out " + (dir / "cpu.vtk").string()).exit_code, 0);
+  ASSERT_EQ(run_solve(scene_file + " --backend cpu --out " + (dir / "cpu.vtk").string()).exit_code,
+            0);
   const SolveRun r = run_solve(scene_file + " --backend gl --out " + (dir / "gl.vtk").string() +
-                          " --stats " + (dir / "gl.json").string());
+                               " --stats " + (dir / "gl.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream js(dir / "gl.json");
   const nlohmann::json j = nlohmann::json::parse(js);

@@ -1,4 +1,4 @@
-// The stats JSON's step_ms bookkeeping (SPEC 4): kinds and their summaries.
+// The stats JSON's step_ms bookkeeping (docs/SCENE.md "Offline run"): kinds and their summaries.
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <gtest/gtest.h>

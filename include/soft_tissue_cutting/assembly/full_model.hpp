@@ -9,9 +9,9 @@
 namespace stc {
 
 struct FullModel {
-  DofMap dofs;      // every DOF of a tet-referenced, non-fixed node
-  SparseMatrix K;   // K_ff
-  Vector f;         // f_f (point loads + gravity)
+  DofMap dofs;     // every DOF of a tet-referenced, non-fixed node
+  SparseMatrix K;  // K_ff
+  Vector f;        // f_f (point loads + gravity)
 };
 
 // loads: global 3n vector; fixed_node: per node.

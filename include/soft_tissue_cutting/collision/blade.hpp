@@ -8,9 +8,9 @@
 namespace stc {
 
 struct BladeEdge {
-  Vec3 tip = Vec3::Zero();             // pose origin
-  Vec3 heel = Vec3::Zero();            // tip + blade_length * local x
-  Vec3 normal = Vec3::UnitY();         // local y, unit
+  Vec3 tip = Vec3::Zero();      // pose origin
+  Vec3 heel = Vec3::Zero();     // tip + blade_length * local x
+  Vec3 normal = Vec3::UnitY();  // local y, unit
 };
 
 BladeEdge blade_edge(const BladePose& pose, double blade_length);

@@ -30,8 +30,9 @@ struct ContactNode {
 };
 
 struct BladeContact {
-  std::vector<ContactNode> nodes;      // ascending by node
-  std::vector<int> crossed_triangles;  // surface triangles the edge crosses (indices into bvh.surface())
+  std::vector<ContactNode> nodes;  // ascending by node
+  std::vector<int>
+      crossed_triangles;  // surface triangles the edge crosses (indices into bvh.surface())
 };
 
 BladeContact blade_contact(const SurfaceBvh& bvh, const TetMesh& mesh, const BladeEdge& edge,

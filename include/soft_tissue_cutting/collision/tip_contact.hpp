@@ -5,8 +5,9 @@
 // nodes follow the tip from where they were at the touch (each node's displacement at the
 // touch plus the tip's motion since), and the tissue's reaction on the blade is minus the
 // force the solve needs at those nodes. The contact ends when the tip withdraws above the point it
-// first touched (the deformed surface at that moment), along that surface's normal. A pure plunge therefore presses; the blade cuts only once the
-// reaction exceeds `cut_pressure` (docs/SCENE.md "Scene file").
+// first touched (the deformed surface at that moment), along that surface's normal. A pure plunge
+// therefore presses; the blade cuts only once the reaction exceeds `cut_pressure` (docs/SCENE.md
+// "Scene file").
 #pragma once
 
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
@@ -20,10 +21,10 @@
 namespace stc {
 
 struct ContactAnchor {
-  Tri nodes;            // the touched surface triangle
+  Tri nodes;                               // the touched surface triangle
   std::array<Vec3, 3> touch_displacement;  // the nodes' displacements at the touch
-  Vec3 touch_point;     // where the tip met the deformed surface
-  Vec3 touch_normal;    // outward unit normal of the deformed triangle there
+  Vec3 touch_point;                        // where the tip met the deformed surface
+  Vec3 touch_normal;                       // outward unit normal of the deformed triangle there
 };
 
 // The first contact of `tip` with the surface triangles (deformed positions x + u): the

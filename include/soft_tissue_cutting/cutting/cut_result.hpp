@@ -43,9 +43,9 @@ struct CutResult {
   // their index for the first child; the other children are appended.
   std::vector<int> changed_tets;
   std::vector<NewNode> new_nodes;
-  int tets_split = 0;        // parent tets bisected (a tet split twice counts twice)
-  int nodes_added = 0;       // edge nodes + duplicates
-  int cut_faces_added = 0;   // net new cut faces (each face once; a halved one counts 1 more)
+  int tets_split = 0;              // parent tets bisected (a tet split twice counts twice)
+  int nodes_added = 0;             // edge nodes + duplicates
+  int cut_faces_added = 0;         // net new cut faces (each face once; a halved one counts 1 more)
   bool reached_interface = false;  // cut faces dropped so a locked node stays whole
 };
 

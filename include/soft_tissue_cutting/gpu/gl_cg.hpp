@@ -35,7 +35,7 @@ class GlCg {
   Texture mask_, minv_;
   Texture x_[2], r_[2], p_[2], z_, q_;
   Texture rz_[2], pq_, alpha_, beta_;  // 1x1
-  int cur_ = 0;     // index of the current x, r, p, rz
+  int cur_ = 0;                        // index of the current x, r, p, rz
 };
 
 }  // namespace gpu

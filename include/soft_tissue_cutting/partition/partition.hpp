@@ -41,7 +41,7 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
 // stay as they are and only the part-1 tets are scanned (no boundary extraction of the whole
 // mesh). Returns false if the change reached part 2 (a changed tet was a part-2 tet, or an
 // interface node stopped being shared): the caller refuses the change.
-bool update_partition_for_operation_change(const TetMesh& mesh, const std::vector<int>& changed_tets,
-                                           Partition& p);
+bool update_partition_for_operation_change(const TetMesh& mesh,
+                                           const std::vector<int>& changed_tets, Partition& p);
 
 }  // namespace stc

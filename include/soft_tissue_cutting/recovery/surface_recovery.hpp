@@ -1,4 +1,4 @@
-// Recovering the condensed part from the interface displacements (METHOD.md section 4):
+// Recovering the condensed part from the interface displacements (docs/DESIGN.md section 5):
 //   u_N = K2_NN^-1 (f_N - K2_NI u_I)      (N = S u Q: the visible surface S is its head)
 // through the sparse factor of K2_NN kept by the condensation: one forward and one backward
 // substitution, exact to rounding. The dense operator R = [K2_NN^-1 K2_NI]_S of the paper

@@ -1,4 +1,4 @@
-// tissue_node: the ROS 1 face of the simulation (SPEC section 5). Thin: all physics is in
+// tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). Thin: all physics is in
 // stc::Simulation; this class owns the threads, the topics, services and parameters. One file
 // per job (src/ros/): tissue_node.cpp wiring, node_params.cpp parameters, scalpel_input.cpp
 // topic/tf2 poses, simulation_loop.cpp the loop (and ~cut slices), node_publishing.cpp
@@ -141,15 +141,15 @@ class TissueNode {
   std::condition_variable cut_done_;
   std::deque<std::shared_ptr<CutJob>> queued_cuts_;
   int cuts_waiting_ = 0;  // service calls waiting for their cut (queued or in progress)
-  std::shared_ptr<CutJob> active_cut_;  // under sim_mutex_
+  std::shared_ptr<CutJob> active_cut_;               // under sim_mutex_
   LoopMonitor::Clock::time_point next_cut_slice_{};  // under sim_mutex_
 
   // What /diagnostics says about the backend: copied under sim_mutex_, read under info_mutex_.
   std::mutex info_mutex_;
   std::string backend_, renderer_, backend_note_;
-  std::string solver_failure_;             // why the last non-converged solve failed
+  std::string solver_failure_;               // why the last non-converged solve failed
   std::string solved_by_, fallback_reason_;  // the last step's (cpu when a gl solve fell back)
-  std::uint64_t steps_ = 0;  // loop thread
+  std::uint64_t steps_ = 0;                  // loop thread
 
   // Display bookkeeping (under sim_mutex_).
   std::uint64_t published_version_ = 0;

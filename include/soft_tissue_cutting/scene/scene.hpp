@@ -78,7 +78,7 @@ struct GeneratorParams {
   // thigh: a thick tube along z; the inner wall is the removed thighbone.
   double inner_radius = 0.015;
   double outer_radius = 0.06;
-  double length = 0.096;  // 8 cells of 12 mm: near-cubic cells at the default resolution
+  double length = 0.096;    // 8 cells of 12 mm: near-cubic cells at the default resolution
   double resolution = 1.0;  // multiplies the number of cells along each direction
   // box
   Vec3 size = Vec3(0.1, 0.02, 0.02);
@@ -86,11 +86,11 @@ struct GeneratorParams {
 };
 
 struct Scene {
-  std::string source;         // file path the scene came from, or "thigh"
-  std::string mesh_file;      // resolved path, empty when generated
+  std::string source;     // file path the scene came from, or "thigh"
+  std::string mesh_file;  // resolved path, empty when generated
   std::optional<GeneratorParams> generator;
   double scale = 1.0;
-  TetMesh mesh;               // loaded/generated, scaled
+  TetMesh mesh;  // loaded/generated, scaled
   Material material;
   std::vector<NodeSelector> fixed;
   std::vector<Load> loads;

@@ -76,8 +76,9 @@ class HybridModel {
   // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
   // (all become operation tets); new_nodes: one entry per appended node, in order (all become
   // O nodes, unloaded; an edge node starts at (1 - t) u_a + t u_b and is fixed only if both
-  // ends are; a duplicate starts at u_a and keeps a's fixed flag). Only the changed element matrices are recomputed; K0, g0, R,
-  // c_S are untouched. Consistent gravity of the changed tets is re-lumped.
+  // ends are; a duplicate starts at u_a and keeps a's fixed flag). Only the changed element
+  // matrices are recomputed; K0, g0, R, c_S are untouched. Consistent gravity of the changed tets
+  // is re-lumped.
   void update_operation_part(const std::vector<int>& changed_tets,
                              const std::vector<NewNode>& new_nodes);
   TetMesh& mesh_for_cutting() { return mesh_; }
@@ -118,23 +119,23 @@ class HybridModel {
 
   TetMesh mesh_;
   Vec3 gravity_ = Vec3::Zero();
-  Vector point_loads_;                  // 3n, new nodes unloaded
-  std::vector<std::uint8_t> fixed_;     // per node
+  Vector point_loads_;               // 3n, new nodes unloaded
+  std::vector<std::uint8_t> fixed_;  // per node
   ElementStiffnessCache elements_;
   Partition partition_;
   CondensedPart condensed_;
-  double condensed_scale_ = 1.0;        // E now / E at condensation time
-  DofMap dofs_;                         // hybrid system over free DOFs of O u I
-  std::vector<int> interface_row_;      // free interface DOF k -> hybrid row
+  double condensed_scale_ = 1.0;    // E now / E at condensation time
+  DofMap dofs_;                     // hybrid system over free DOFs of O u I
+  std::vector<int> interface_row_;  // free interface DOF k -> hybrid row
   SparseMatrix a_;
-  SparseMatrix k0_padded_;              // K0 as a sparse block (3|I|_free square), see rebuild
+  SparseMatrix k0_padded_;  // K0 as a sparse block (3|I|_free square), see rebuild
   Vector b_;
   // u_ is mutable for the on-demand recovery of its S and Q entries in displacement().
   mutable Vector u_;
   mutable Vector recovered_from_;        // u_I the S and Q entries were recovered from
   mutable bool condensed_stale_ = true;  // u_I moved since then
   mutable long recoveries_ = 0;
-  bool system_changed_ = true;           // matrix, rhs or u_ changed since the last solve
+  bool system_changed_ = true;  // matrix, rhs or u_ changed since the last solve
   ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;
   CgSettings settings_;

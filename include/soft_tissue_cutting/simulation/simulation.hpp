@@ -27,8 +27,8 @@ struct SimulationOptions {
 struct StepStats {
   std::uint64_t step = 0;
   bool in_contact = false;
-  bool cutting = false;               // this step inserted a cut
-  Vec3 contact_force = Vec3::Zero();  // N, reaction of the tissue on the blade (scene frame)
+  bool cutting = false;                // this step inserted a cut
+  Vec3 contact_force = Vec3::Zero();   // N, reaction of the tissue on the blade (scene frame)
   Vec3 contact_torque = Vec3::Zero();  // N m, its moment about the blade tip (scene frame)
   std::vector<int> contact_nodes;      // the nodes the blade holds this step, ascending
   std::vector<Vec3> contact_points;    // where it holds them (deformed, scene frame)
@@ -40,9 +40,9 @@ struct StepStats {
   // fallback_reason says why in one line.
   std::string solved_by;
   std::string fallback_reason;
-  std::string solver_message;  // one line when !converged: why the solve stopped short
-  int tets_split = 0;   // this step
-  int nodes_added = 0;  // this step
+  std::string solver_message;      // one line when !converged: why the solve stopped short
+  int tets_split = 0;              // this step
+  int nodes_added = 0;             // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
   double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
   double step_ms = 0;
@@ -124,10 +124,10 @@ class Simulation {
   std::uint64_t surface_version() const;  // changes whenever the drawn surface changes
   ModelCounts counts() const;
   const StepStats& last_stats() const;
-  std::string backend() const;   // solver actually in use: "cpu" or "gl"
-  std::string renderer() const;  // GL renderer for "gl"
-  std::string backend_note() const;  // why gl fell back to cpu, if it did
-  std::string backend_requested() const;  // "cpu" or "gl": the option, else the scene's
+  std::string backend() const;                    // solver actually in use: "cpu" or "gl"
+  std::string renderer() const;                   // GL renderer for "gl"
+  std::string backend_note() const;               // why gl fell back to cpu, if it did
+  std::string backend_requested() const;          // "cpu" or "gl": the option, else the scene's
   std::vector<std::uint8_t> tet_regions() const;  // 1 = operation part, per tet
   std::vector<BladePose> blade_path() const;      // poses of the current scalpel stroke
 
@@ -136,8 +136,7 @@ class Simulation {
   // docs/SCENE.md "Offline run" outputs. Throw std::runtime_error with a one-line reason.
   void write_vtk(const std::string& path);
   // `steps`: the step times for `step_ms`; nullptr = every step since the start (or reset).
-  void write_stats_json(const std::string& path, double total_ms,
-                        const StepTimes* steps = nullptr);
+  void write_stats_json(const std::string& path, double total_ms, const StepTimes* steps = nullptr);
   std::string stats_json(double total_ms, const StepTimes* steps = nullptr);
   // Wall time of every step() since the start (or the last reset), by kind.
   const StepTimes& step_times() const;

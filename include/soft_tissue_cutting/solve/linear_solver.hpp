@@ -45,7 +45,7 @@ std::string iteration_cap_message(const CgResult& result, const CgSettings& sett
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
-  virtual std::string backend() const = 0;          // "cpu" or "gl"
+  virtual std::string backend() const = 0;             // "cpu" or "gl"
   virtual std::string renderer() const { return ""; }  // GL renderer string for "gl"
   // The preconditioner in use for the current matrix ("jacobi", "cholesky", ...); it may
   // differ from the one asked for when set_matrix had to fall back. Empty if not reported.
