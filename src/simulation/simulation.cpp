@@ -368,7 +368,7 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     if (!cut.crossed) {
       const BladeEdge e = blade_edge(from, length);
       for (const Vec3& x : {e.tip, Vec3(0.5 * (e.tip + e.heel)), e.heel})
-        cut.crossed = cut.crossed || tip_inside_tissue(mesh(), impl_->cut_state, x);
+        cut.crossed = cut.crossed || inside_rest_tissue(mesh(), impl_->cut_state, x);
     }
     StepStats s;
     changed |= impl_->cut(from, to, s);
