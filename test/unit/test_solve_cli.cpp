@@ -204,7 +204,7 @@ TEST(SolveCli, NonConvergedFinalSolveExits3AfterWritingOutputs) {
   const fs::path scene = dir / "capped.yaml";
   const auto write_scene = [&](int max_iterations) {
     std::ofstream(scene)
-        << "mesh: {file: " << kScenes << "../../test/data/sofa_liver.msh, scale: 0.02}\n"
+        << "mesh: {file: " << kScenes << "../meshes/sofa_liver.msh, scale: 0.02}\n"
         << "material: {young_modulus: 3000.0, poisson_ratio: 0.3}\n"
         << "fixed: [{nodes: [2, 38, 63]}]\n"
         << "gravity: [0.0, -9.81, 0.0]\n"
