@@ -2,9 +2,9 @@
 // the blade's edge contact, collision/edge_contact) + cut insertion (split, mark, separate), on the
 // scripted scalpel's drawing stroke through the operation region. Counter: tets added per cm of
 // cut.
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
 #include <benchmark/benchmark.h>

@@ -9,9 +9,9 @@
 // only about pass overheads; docs/DESIGN.md section 14: llvmpipe is for correctness.
 // Times are per SpMV / per CG iteration; use --benchmark_repetitions for medians.
 #include "common/test_matrices.hpp"
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
-#include "soft_tissue_cutting/gpu/gl_cg.hpp"
-#include "soft_tissue_cutting/gpu/gl_vector.hpp"
+#include "gpu/egl_context.hpp"
+#include "gpu/gl_cg.hpp"
+#include "gpu/gl_vector.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,9 +1,9 @@
 // Cut insertion, the special cases: partial cuts that continue, cuts exactly through nodes,
 // along edges and along faces, re-cutting, severing, and locked (interface) nodes.
 #include "common/cut_measures.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
-#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
+#include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 

@@ -3,9 +3,9 @@
 // edges and faces, repeated, continued, severing). After EVERY sweep all invariants of
 // docs/SCENE.md "Cut invariants" must hold (cutting/invariants.hpp).
 #include "common/cut_measures.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
-#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
+#include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/io/mesh_reader.hpp"

@@ -1,8 +1,8 @@
 // Cut insertion on a structured box: exact areas, volumes and separation (issue 4).
 #include "common/cut_measures.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
-#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
+#include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 

@@ -2,9 +2,9 @@
 // RowLoop layout against a double-precision CPU SpMV. EGL must work here (docs/DESIGN.md section
 // 14, "Headless EGL compute"): a missing context is a failure, not a skip.
 #include "common/test_matrices.hpp"
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
-#include "soft_tissue_cutting/gpu/gl_spmv.hpp"
-#include "soft_tissue_cutting/gpu/gl_vector.hpp"
+#include "gpu/egl_context.hpp"
+#include "gpu/gl_spmv.hpp"
+#include "gpu/gl_vector.hpp"
 
 #include <gtest/gtest.h>
 

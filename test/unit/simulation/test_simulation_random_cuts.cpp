@@ -3,7 +3,7 @@
 // solve). After every sweep: the geometric invariants, a symmetric hybrid matrix that is positive
 // definite on the free DOF (held pieces excluded: they are constrained), a converged finite
 // solution.
-#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"

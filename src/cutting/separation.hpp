@@ -9,7 +9,7 @@
 // returns towards the previous (valid) state, so the loop ends with a closed 2-manifold.
 #pragma once
 
-#include "soft_tissue_cutting/cutting/triangle_cut.hpp"
+#include "cutting/triangle_cut.hpp"
 
 #include <set>
 

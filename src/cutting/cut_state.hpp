@@ -2,7 +2,7 @@
 // function takes (TetMesh&, CutState&) and grows both together.
 #pragma once
 
-#include "soft_tissue_cutting/cutting/tet_grid.hpp"
+#include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
 
 #include <array>

@@ -1,7 +1,7 @@
 // Conforming edge bisection: insert a node on an edge and split every tet that uses it.
 #pragma once
 
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
+#include "cutting/cut_state.hpp"
 
 namespace stc {
 

@@ -7,8 +7,8 @@
 // saw. Separation (separation.hpp) comes after.
 #pragma once
 
+#include "cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
 
 #include <array>
 #include <set>

@@ -3,8 +3,8 @@
 // Binds programs, input textures and targets (one or several, MRT), counts passes.
 #pragma once
 
-#include "soft_tissue_cutting/gpu/gl_texture.hpp"
-#include "soft_tissue_cutting/gpu/shader_library.hpp"
+#include "gpu/gl_texture.hpp"
+#include "gpu/shader_library.hpp"
 
 #include <initializer_list>
 #include <map>

@@ -8,9 +8,9 @@
 // (separation.hpp). Coordinates are REST coordinates: the mesh's nodes are rest positions.
 #pragma once
 
+#include "cutting/cut_state.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
 
 #include <vector>
 
@@ -20,7 +20,8 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
                     const CutOptions& options = {});
 
 // Any list of planar triangles, inserted as one cut (one separation at the end).
-// also_mark_in: see insert_cut_triangle.
+// also_mark_in: earlier triangles of the same stroke; faces this cut creates that lie in one of
+// them are marked too (the split around a new triangle can expose a face of an old one).
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options = {},

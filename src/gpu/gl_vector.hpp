@@ -2,7 +2,7 @@
 // texel (i & (width-1), i >> shift); padding texels hold 0 so reductions may sum them.
 #pragma once
 
-#include "soft_tissue_cutting/gpu/gl_texture.hpp"
+#include "gpu/gl_texture.hpp"
 #include "soft_tissue_cutting/gpu/matrix_layout.hpp"
 
 namespace stc {

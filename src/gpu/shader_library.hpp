@@ -5,7 +5,7 @@
 // TISSUE_INSTALL_SHADER_DIR (installed package). Each program compiles once per context.
 #pragma once
 
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
+#include "gpu/egl_context.hpp"
 
 #include <map>
 #include <string>

@@ -5,8 +5,8 @@
 // It solves A d = r0 from d = 0 (GlSolver uses it for each iterative-refinement step).
 #pragma once
 
-#include "soft_tissue_cutting/gpu/gl_reduction.hpp"
-#include "soft_tissue_cutting/gpu/gl_spmv.hpp"
+#include "gpu/gl_reduction.hpp"
+#include "gpu/gl_spmv.hpp"
 
 namespace stc {
 namespace gpu {

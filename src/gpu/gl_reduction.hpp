@@ -4,7 +4,7 @@
 // stays on the GPU (alpha and beta are computed from it by shaders).
 #pragma once
 
-#include "soft_tissue_cutting/gpu/gl_pass.hpp"
+#include "gpu/gl_pass.hpp"
 #include "soft_tissue_cutting/gpu/matrix_layout.hpp"
 
 #include <vector>

@@ -2,8 +2,8 @@
 // three layouts of matrix_layout.hpp. Needs the owning context current.
 #pragma once
 
-#include "soft_tissue_cutting/gpu/gl_pass.hpp"
-#include "soft_tissue_cutting/gpu/gl_texture.hpp"
+#include "gpu/gl_pass.hpp"
+#include "gpu/gl_texture.hpp"
 #include "soft_tissue_cutting/gpu/matrix_layout.hpp"
 
 namespace stc {
