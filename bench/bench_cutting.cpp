@@ -1,12 +1,15 @@
 // Cutting on the thigh (issue 4): one cutting sweep = collision query (surface BVH refit and
-// blade contact) + cut insertion (split, mark, separate), on the scripted scalpel's drawing
-// stroke through the operation region. Counter: tets added per cm of cut.
-#include "soft_tissue_cutting/collision/contact.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
+// the blade's edge contact, collision/edge_contact) + cut insertion (split, mark, separate), on the
+// scripted scalpel's drawing stroke through the operation region. Counter: tets added per cm of
+// cut.
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
+#include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <optional>
 
 namespace stc {
 namespace {
@@ -45,13 +48,17 @@ void BM_CuttingSweep(benchmark::State& state) {
     CutState cut = make_cut_state(mesh, {}, thigh.cuttable);
     SurfaceBvh bvh;
     bvh.build(mesh, thigh.cuttable, {});
+    EdgeContact contact;
+    std::optional<BladeEdge> previous;
     const int tets_before = mesh.num_tets();
     state.ResumeTiming();
     for (int k = 0; k < steps; ++k) {
       const BladeEdge from = edge_at(static_cast<double>(k) / steps),
                       to = edge_at(static_cast<double>(k + 1) / steps);
       bvh.refit(mesh, {});
-      benchmark::DoNotOptimize(blade_contact(bvh, mesh, to, 1e-6));
+      const Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * mesh.num_nodes());
+      benchmark::DoNotOptimize(contact.update(bvh, mesh, u, previous, to));
+      previous = to;
       const CutResult r = cut_sweep(mesh, cut, from, to);
       if (r.nodes_added > 0) bvh.build(mesh, cut.cuttable, {});  // the surface changed
     }

@@ -8,10 +8,10 @@
 // llvmpipe (software rasterizer on the CPU) the numbers say nothing about real GPU speed,
 // only about pass overheads; docs/DESIGN.md section 14: llvmpipe is for correctness.
 // Times are per SpMV / per CG iteration; use --benchmark_repetitions for medians.
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
-#include "soft_tissue_cutting/gpu/gl_cg.hpp"
-#include "soft_tissue_cutting/gpu/gl_vector.hpp"
-#include "soft_tissue_cutting/gpu/test_matrices.hpp"
+#include "common/test_matrices.hpp"
+#include "gpu/egl_context.hpp"
+#include "gpu/gl_cg.hpp"
+#include "gpu/gl_vector.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -24,6 +24,9 @@
 
 namespace stc {
 namespace gpu {
+using test::elasticity_like;
+using test::random_vector;
+using test::table2_matrix;
 namespace {
 
 struct Gl {

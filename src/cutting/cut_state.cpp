@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
+#include "cutting/cut_state.hpp"
 
 #include <algorithm>
 #include <stdexcept>

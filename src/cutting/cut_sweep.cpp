@@ -1,7 +1,7 @@
-#include "soft_tissue_cutting/cutting/cut_sweep.hpp"
+#include "cutting/cut_sweep.hpp"
 
-#include "soft_tissue_cutting/cutting/separation.hpp"
-#include "soft_tissue_cutting/cutting/triangle_cut.hpp"
+#include "cutting/separation.hpp"
+#include "cutting/triangle_cut.hpp"
 
 #include <algorithm>
 

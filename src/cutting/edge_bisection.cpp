@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/cutting/edge_bisection.hpp"
+#include "cutting/edge_bisection.hpp"
 
 #include <algorithm>
 

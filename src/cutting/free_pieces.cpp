@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "cutting/free_pieces.hpp"
 
 #include <algorithm>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/cutting/separation.hpp"
+#include "cutting/separation.hpp"
 
 #include <algorithm>
 #include <map>

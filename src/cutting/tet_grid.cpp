@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/cutting/tet_grid.hpp"
+#include "cutting/tet_grid.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-#include "soft_tissue_cutting/cutting/triangle_cut.hpp"
+#include "cutting/triangle_cut.hpp"
 
-#include "soft_tissue_cutting/cutting/edge_bisection.hpp"
+#include "cutting/edge_bisection.hpp"
 
 #include <algorithm>
 #include <cmath>

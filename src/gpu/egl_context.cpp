@@ -1,7 +1,7 @@
 // Headless EGL context creation (see egl_context.hpp). EGL and GL entry points come from
 // libepoxy, so extension functions (eglQueryDevicesEXT, eglGetPlatformDisplayEXT) need no
 // hand-written eglGetProcAddress table.
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
+#include "gpu/egl_context.hpp"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>

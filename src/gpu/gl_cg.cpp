@@ -1,7 +1,7 @@
 // Whole CG on the GPU (see gl_cg.hpp).
-#include "soft_tissue_cutting/gpu/gl_cg.hpp"
+#include "gpu/gl_cg.hpp"
 
-#include "soft_tissue_cutting/gpu/gl_vector.hpp"
+#include "gpu/gl_vector.hpp"
 
 #include <epoxy/gl.h>
 

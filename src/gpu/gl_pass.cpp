@@ -1,5 +1,5 @@
 // Full-screen fragment passes (see gl_pass.hpp).
-#include "soft_tissue_cutting/gpu/gl_pass.hpp"
+#include "gpu/gl_pass.hpp"
 
 #include <epoxy/gl.h>
 

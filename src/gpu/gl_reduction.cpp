@@ -1,5 +1,5 @@
 // Halving sum reductions (see gl_reduction.hpp).
-#include "soft_tissue_cutting/gpu/gl_reduction.hpp"
+#include "gpu/gl_reduction.hpp"
 
 #include <epoxy/gl.h>
 

@@ -4,8 +4,8 @@
 // requested tolerance, or until they stop gaining (cond beyond ~1e7) and the CPU takes over.
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 
-#include "soft_tissue_cutting/gpu/egl_context.hpp"
-#include "soft_tissue_cutting/gpu/gl_cg.hpp"
+#include "gpu/egl_context.hpp"
+#include "gpu/gl_cg.hpp"
 
 #include <algorithm>
 #include <cmath>

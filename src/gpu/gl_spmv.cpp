@@ -1,5 +1,5 @@
 // Texture SpMV (see gl_spmv.hpp).
-#include "soft_tissue_cutting/gpu/gl_spmv.hpp"
+#include "gpu/gl_spmv.hpp"
 
 #include <epoxy/gl.h>
 

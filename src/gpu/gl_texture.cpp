@@ -1,5 +1,5 @@
 // Texture RAII and transfers (see gl_texture.hpp).
-#include "soft_tissue_cutting/gpu/gl_texture.hpp"
+#include "gpu/gl_texture.hpp"
 
 #include <epoxy/gl.h>
 

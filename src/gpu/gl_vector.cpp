@@ -1,5 +1,5 @@
 // Vector <-> R32F texture transfers (see gl_vector.hpp).
-#include "soft_tissue_cutting/gpu/gl_vector.hpp"
+#include "gpu/gl_vector.hpp"
 
 #include <epoxy/gl.h>
 

@@ -1,5 +1,5 @@
 // Shader lookup, compilation and caching (see shader_library.hpp).
-#include "soft_tissue_cutting/gpu/shader_library.hpp"
+#include "gpu/shader_library.hpp"
 
 #include <epoxy/gl.h>
 

@@ -1,7 +1,7 @@
 // The tissue's current boundary surface at its DEFORMED positions (rest + displacement), in
 // an AABB tree: what the blade is tested against every step. Triangles owned by operation-part
-// tets are the ones the blade can touch (contact.hpp); the whole closed surface answers
-// point-in-tissue queries by ray parity.
+// tets are the ones the blade can touch (edge_contact.hpp, tip_contact.hpp); the whole closed
+// surface answers point-in-tissue queries by ray parity.
 #pragma once
 
 #include "soft_tissue_cutting/collision/aabb_tree.hpp"

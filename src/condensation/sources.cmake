@@ -1,0 +1,4 @@
+# The condensation stage's sources of tissue_core (explicit: a new file is added here).
+list(APPEND TISSUE_CORE_SOURCES
+  src/condensation/condensed_part.cpp
+)

@@ -1,0 +1,46 @@
+// What the cutter keeps beside the TetMesh between cuts, index-aligned with it. Every cutting
+// function takes (TetMesh&, CutState&) and grows both together.
+#pragma once
+
+#include "cutting/tet_grid.hpp"
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace stc {
+
+struct CutState {
+  // Per node: never duplicated by a cut (the interface to the condensed part). Nodes of
+  // non-cuttable tets are always locked (make_cut_state enforces it), so "an edge with both
+  // ends locked is never split" also keeps every edge of a non-cuttable tet whole.
+  std::vector<std::uint8_t> locked;
+  // Per tet: part of the operation part; only these are split, cut or separated.
+  std::vector<std::uint8_t> cuttable;
+  // Per tet: the volume of the original input tet it descends from (its "size class", docs/SCENE.md
+  // "Cut invariants").
+  std::vector<double> origin_volume;
+  // Per node: the tets that use it (kept up to date by every edit).
+  std::vector<std::vector<int>> node_tets;
+  // Cuttable tets by rest-position box.
+  TetGrid grid;
+  // The current stroke's sweep triangles (every sweep since the blade began this continuous
+  // cut, capped) and the last sweep's end edge (tip, heel). A sweep that starts where the last
+  // one ended also marks faces whose centroid lies in the stroke's earlier triangles: faces
+  // that only appear when this sweep splits the tets around them, and that this sweep's own
+  // triangles would not claim.
+  std::vector<std::array<Vec3, 3>> last_sweep;
+  std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
+};
+
+// locked: per node (empty = none); cuttable: per tet (empty = all). Also sizes
+// mesh.cut_faces to one entry per tet.
+CutState make_cut_state(TetMesh& mesh, std::vector<std::uint8_t> locked,
+                        std::vector<std::uint8_t> cuttable);
+
+// The tets that use both a and b, ascending.
+std::vector<int> tets_with_edge(const CutState& state, int a, int b);
+
+}  // namespace stc

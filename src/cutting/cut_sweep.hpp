@@ -1,0 +1,30 @@
+// One cutting step: the surface the blade edge sweeps between two poses, inserted into the
+// operation part of the mesh in place (docs/DESIGN.md section 8), keeping docs/SCENE.md "Cut
+// invariants".
+//
+// The sweep between edges (A0, B0) and (A1, B1) (A = tip, B = heel) is a bilinear patch,
+// approximated by the planar triangles (A0, B0, B1) and (A0, B1, A1). Each triangle is
+// inserted (split + mark, triangle_cut.hpp), then the marked faces are opened
+// (separation.hpp). Coordinates are REST coordinates: the mesh's nodes are rest positions.
+#pragma once
+
+#include "cutting/cut_state.hpp"
+#include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/cutting/cut_result.hpp"
+
+#include <vector>
+
+namespace stc {
+
+CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const BladeEdge& to,
+                    const CutOptions& options = {});
+
+// Any list of planar triangles, inserted as one cut (one separation at the end).
+// also_mark_in: earlier triangles of the same stroke; faces this cut creates that lie in one of
+// them are marked too (the split around a new triangle can expose a face of an old one).
+CutResult cut_triangles(TetMesh& mesh, CutState& state,
+                        const std::vector<std::array<Vec3, 3>>& triangles,
+                        const CutOptions& options = {},
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {});
+
+}  // namespace stc

@@ -1,0 +1,23 @@
+// Opening marked cut faces (step d-e of the cut): a node whose tet star falls apart into k
+// pieces when the marked faces are removed from its adjacency is duplicated k - 1 times.
+//
+// At a crack front the star stays connected through the unmarked faces ahead of the cut, so
+// the front stays closed and the marks wait for the next sweep to continue the cut. Before
+// anything is changed the planned result is checked: a locked node that would be duplicated,
+// or an edge that would end up in more than two boundary triangles, gets the still-closed
+// marked faces around it unmarked and the plan is redone. Dropping closed marks only ever
+// returns towards the previous (valid) state, so the loop ends with a closed 2-manifold.
+#pragma once
+
+#include "cutting/triangle_cut.hpp"
+
+#include <set>
+
+namespace stc {
+
+// region_tets: the tets the cut touched (marked faces elsewhere are left alone). new_faces
+// loses the faces that had to be dropped. Duplicates are appended to result.new_nodes.
+void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>& region_tets,
+                         CutResult& result, std::set<FaceKey>& new_faces);
+
+}  // namespace stc

@@ -1,0 +1,8 @@
+# The simulation stage's sources of tissue_core (explicit: a new file is added here).
+list(APPEND TISSUE_CORE_SOURCES
+  src/simulation/hybrid_model.cpp
+  src/simulation/operation_surface.cpp
+  src/simulation/simulation.cpp
+  src/simulation/simulation_output.cpp
+  src/simulation/step_times.cpp
+)

@@ -1,0 +1,16 @@
+// Simple measures of the cut surface, for the cutting and simulation tests (a test helper, not part
+// of tissue_core).
+#pragma once
+
+#include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+
+namespace stc::test {
+
+// Total area (rest configuration) of the boundary triangles marked as cut. An opened cut of
+// area A contributes 2 A (one triangle on each lip).
+double open_cut_area(const TetMesh& mesh);
+
+// Number of cut faces still closed (marked, shared by two tets): a crack front waiting.
+int closed_cut_faces(const TetMesh& mesh);
+
+}  // namespace stc::test

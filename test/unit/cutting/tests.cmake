@@ -1,0 +1,7 @@
+# Unit tests of src/cutting/ (tissue_core_unit; explicit: a new test file is added here).
+list(APPEND TISSUE_UNIT_TESTS
+  test/unit/cutting/test_blade_path.cpp
+  test/unit/cutting/test_cut_cases.cpp
+  test/unit/cutting/test_cut_property.cpp
+  test/unit/cutting/test_cut_sweep_box.cpp
+)
