@@ -25,10 +25,16 @@ struct SparseCholesky::Impl {
 SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
 SparseCholesky::~SparseCholesky() = default;
 
-SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method)
+SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
+                               CholeskyOrdering ordering)
     : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
   impl_->method = method;
   if (rows_ == 0) return;
+  if (ordering == CholeskyOrdering::kAmd)
+    for (cholmod_common* c : {&impl_->simplicial.cholmod(), &impl_->supernodal.cholmod()}) {
+      c->nmethods = 1;
+      c->method[0].ordering = CHOLMOD_AMD;
+    }
   const Impl::ColMatrix col(a);
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
