@@ -17,6 +17,10 @@
 //             the identity plus rank <= #constrained DOFs. CG therefore needs at most
 //             #constrained + 1 iterations in exact arithmetic, whatever the condition of A, and
 //             none without constraints beyond the one exact step. Contact touches a few nodes.
+//             Before any CG iteration, the held DOFs are solved for directly through the same
+//             factor and a k x k capacitance system (docs/DESIGN.md eqs. (24)-(25),
+//             held_dof_solve.cpp), counted as one iteration; CG runs only if its true residual
+//             misses the tolerance.
 // A held free piece (simulation.cpp) makes A singular: its rigid modes are unanchored, though
 // every DOF of it is constrained. The piece is its own connected block of A, so A + d*diag(A)
 // with tiny d keeps (A^-1)_ff of the anchored rest to ~d*cond(A) and only perturbs the piece,
@@ -86,8 +90,7 @@ class CpuCgSolver final : public LinearSolver {
     // is read from the held rows alone (no whole product for a few held DOFs).
     Vector reduced = b;
     for (int c : held)
-      for (SparseMatrix::InnerIterator it(a_, c); it; ++it)
-        reduced[it.col()] -= it.value() * x[c];
+      for (SparseMatrix::InnerIterator it(a_, c); it; ++it) reduced[it.col()] -= it.value() * x[c];
     const double rhs_norm = reduced.cwiseProduct(free_mask).norm();
     if (n == 0 || rhs_norm == 0) {
       x = x.cwiseProduct(Vector::Ones(n) - free_mask);  // x_f = 0 solves it exactly
@@ -176,7 +179,8 @@ class CpuCgSolver final : public LinearSolver {
   void factor() {
     if (a_.rows() == 0) return;
     try {
-      chol_ = std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal, CholeskyOrdering::kAmd);
+      chol_ =
+          std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal, CholeskyOrdering::kAmd);
       active_ = "cholesky";
       return;
     } catch (const std::runtime_error&) {
