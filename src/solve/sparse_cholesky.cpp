@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace stc {
@@ -35,7 +36,18 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
       c->nmethods = 1;
       c->method[0].ordering = CHOLMOD_AMD;
     }
-  const Impl::ColMatrix col(a);
+  // A is symmetric, so its row-major arrays are also its column-major arrays: copied as they
+  // are instead of transposed (CHOLMOD reads the lower triangle: A's upper one, equal to
+  // rounding).
+  Impl::ColMatrix col(a.rows(), a.cols());
+  if (a.isCompressed()) {
+    col.resizeNonZeros(a.nonZeros());
+    std::copy(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1, col.outerIndexPtr());
+    std::copy(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), col.innerIndexPtr());
+    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), col.valuePtr());
+  } else {
+    col = a;
+  }
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
   Eigen::ComputationInfo info;
