@@ -13,6 +13,50 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// Consistent gravity (rho g V / 4 per node, as gravity_loads) of the listed tets only, into f.
+void add_gravity_of(const TetMesh& mesh, const std::vector<int>& tets, double density,
+                    const Vec3& gravity, Vector& f) {
+  if (gravity.isZero(0.0)) return;
+  for (int t : tets) {
+    const Vec3 share = density * tet_volume(mesh, t) / 4.0 * gravity;
+    for (int n : mesh.tets[static_cast<size_t>(t)]) f.segment<3>(3 * n) += share;
+  }
+}
+
+// a = K1 + K0 with K0 (dense, ni x ni, row-major) on the leading rows and columns: one merge
+// of sorted rows into a's compressed arrays. Rows below ni are K1's as they are.
+void merge_k0(const SparseMatrix& k1, const SparseMatrix& k0, SparseMatrix& a) {
+  const int n = static_cast<int>(k1.rows()), ni = static_cast<int>(k0.rows());
+  a.resize(n, n);
+  a.resizeNonZeros(k1.nonZeros() + k0.nonZeros());  // an upper bound, trimmed below
+  int* outer = a.outerIndexPtr();
+  int* inner = a.innerIndexPtr();
+  double* value = a.valuePtr();
+  int out = 0;
+  for (int r = 0; r < n; ++r) {
+    outer[r] = out;
+    const int* ki = k1.innerIndexPtr() + k1.outerIndexPtr()[r];
+    const double* kv = k1.valuePtr() + k1.outerIndexPtr()[r];
+    const int kn = k1.outerIndexPtr()[r + 1] - k1.outerIndexPtr()[r];
+    int zi0 = 0, zn = 0;
+    if (r < ni) zi0 = k0.outerIndexPtr()[r], zn = k0.outerIndexPtr()[r + 1] - zi0;
+    const int* zi = k0.innerIndexPtr() + zi0;
+    const double* zv = k0.valuePtr() + zi0;
+    int i = 0, j = 0;
+    while (i < kn || j < zn) {
+      if (j >= zn || (i < kn && ki[i] < zi[j])) {
+        inner[out] = ki[i], value[out++] = kv[i++];
+      } else if (i >= kn || zi[j] < ki[i]) {
+        inner[out] = zi[j], value[out++] = zv[j++];
+      } else {
+        inner[out] = ki[i], value[out++] = kv[i++] + zv[j++];
+      }
+    }
+  }
+  outer[n] = out;
+  a.resizeNonZeros(out);
+}
+
 }  // namespace
 
 HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solver)
@@ -37,6 +81,10 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
   // below), so only f_N reaches the condensation.
   condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
+  // Part 2's gravity never changes: kept, so a cut re-lumps the operation tets only.
+  condensed_gravity_ = Vector::Zero(3 * mesh_.num_nodes());
+  add_gravity_of(mesh_, partition_.condensed_tets, elements_.material().density, gravity_,
+                 condensed_gravity_);
   timings_["condensation_assembly"] = condensed_.assembly_ms;
   timings_["condensation_factor"] = condensed_.factor_ms;
   timings_["condensation_solve"] = condensed_.solve_ms;
@@ -79,12 +127,14 @@ void HybridModel::rebuild_hybrid_system() {
   add_element_triplets(mesh_, elements_, partition_.operation_tets, dofs_.row_of, dofs_.row_of, t);
   SparseMatrix k1(n, n);
   k1.setFromTriplets(t.begin(), t.end());
-  SparseMatrix k0 = k0_padded_;
-  k0.conservativeResize(n, n);
-  a_ = k1 + k0;
+  merge_k0(k1, k0_padded_, a_);
 
-  // Right-hand side: f_O, f_I - g0.
-  b_ = gather(loads(), dofs_);
+  // Right-hand side: f_O, f_I - g0. The loads of the whole mesh, with part 2's gravity kept
+  // from the start (a cut changes part-1 tets only).
+  Vector f = point_loads_;
+  f.head(condensed_gravity_.size()) += condensed_gravity_;
+  add_gravity_of(mesh_, partition_.operation_tets, elements_.material().density, gravity_, f);
+  b_ = gather(f, dofs_);
   for (int k = 0; k < idofs.rows(); ++k)
     b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
   solver_->set_matrix(a_);

@@ -17,14 +17,20 @@
 //             the identity plus rank <= #constrained DOFs. CG therefore needs at most
 //             #constrained + 1 iterations in exact arithmetic, whatever the condition of A, and
 //             none without constraints beyond the one exact step. Contact touches a few nodes.
+//             Before any CG iteration, the held DOFs are solved for directly through the same
+//             factor and a k x k capacitance system (docs/DESIGN.md eqs. (24)-(25),
+//             held_dof_solve.cpp), counted as one iteration; CG runs only if its true residual
+//             misses the tolerance.
 // A held free piece (simulation.cpp) makes A singular: its rigid modes are unanchored, though
 // every DOF of it is constrained. The piece is its own connected block of A, so A + d*diag(A)
 // with tiny d keeps (A^-1)_ff of the anchored rest to ~d*cond(A) and only perturbs the piece,
 // which P zeroes: that is the second attempt. An indefinite A (no SPD factor even shifted)
 // falls back to Jacobi for that matrix; preconditioner() reports it.
+#include "soft_tissue_cutting/solve/held_dof_solve.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +64,7 @@ class CpuCgSolver final : public LinearSolver {
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
     chol_.reset();
+    held_.reset();
     active_ = "jacobi";
     if (wanted_ == CgPreconditioner::kCholesky) factor();
     setup_ms_ =
@@ -71,13 +78,20 @@ class CpuCgSolver final : public LinearSolver {
     result.solved_by = "cpu";
     if (x.size() != n) x = Vector::Zero(n);
     Vector free_mask = Vector::Ones(n);
+    std::vector<int> held;
     if (!constrained.empty())
       for (Eigen::Index i = 0; i < n; ++i)
-        if (constrained[static_cast<size_t>(i)]) free_mask[i] = 0;
+        if (constrained[static_cast<size_t>(i)]) {
+          free_mask[i] = 0;
+          held.push_back(static_cast<int>(i));
+        }
 
-    // Reduced right-hand side b_f - A_fc x_c, for the denominator.
-    const Vector xc = x.cwiseProduct(Vector::Ones(n) - free_mask);
-    const double rhs_norm = (b - a_ * xc).cwiseProduct(free_mask).norm();
+    // Reduced right-hand side b_f - A_fc x_c, for the denominator: A is symmetric, so A_fc x_c
+    // is read from the held rows alone (no whole product for a few held DOFs).
+    Vector reduced = b;
+    for (int c : held)
+      for (SparseMatrix::InnerIterator it(a_, c); it; ++it) reduced[it.col()] -= it.value() * x[c];
+    const double rhs_norm = reduced.cwiseProduct(free_mask).norm();
     if (n == 0 || rhs_norm == 0) {
       x = x.cwiseProduct(Vector::Ones(n) - free_mask);  // x_f = 0 solves it exactly
       result.converged = true;
@@ -88,6 +102,25 @@ class CpuCgSolver final : public LinearSolver {
       if (chol_) return chol_->solve(r).cwiseProduct(free_mask);
       return m.cwiseProduct(r);
     };
+
+    // With the factor of A: the direct solve through the capacitance on the held DOFs
+    // (docs/DESIGN.md eqs. (24)-(25)), counted as one iteration, unless the warm start
+    // already solves the system. Its true residual decides; CG goes on from it otherwise.
+    if (chol_ && settings.max_iterations > 0) {
+      const double warm = (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
+      if (warm > settings.tolerance) {
+        Vector direct = x;
+        held_.solve(*chol_, b, held, direct);
+        result.iterations = 1;
+        const double res = (b - a_ * direct).cwiseProduct(free_mask).norm() / rhs_norm;
+        if (res < warm) x = std::move(direct);
+        result.residual = std::min(res, warm);
+        if (result.residual <= settings.tolerance) {
+          result.converged = true;
+          return result;
+        }
+      }
+    }
 
     // Restart from the true residual if the recursive one converged but the true one did not
     // (loss of orthogonality at very tight tolerances).
@@ -146,7 +179,8 @@ class CpuCgSolver final : public LinearSolver {
   void factor() {
     if (a_.rows() == 0) return;
     try {
-      chol_ = std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal);
+      chol_ =
+          std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal, CholeskyOrdering::kAmd);
       active_ = "cholesky";
       return;
     } catch (const std::runtime_error&) {
@@ -158,7 +192,8 @@ class CpuCgSolver final : public LinearSolver {
       shifted.coeffRef(i, i) += kShift * (d > 0 ? d : dmax);
     }
     try {
-      chol_ = std::make_unique<SparseCholesky>(shifted, CholeskyMethod::kSupernodal);
+      chol_ = std::make_unique<SparseCholesky>(shifted, CholeskyMethod::kSupernodal,
+                                               CholeskyOrdering::kAmd);
       active_ = "cholesky (shifted)";
     } catch (const std::runtime_error&) {
       chol_.reset();
@@ -169,6 +204,7 @@ class CpuCgSolver final : public LinearSolver {
   SparseMatrix a_;
   Vector inv_diag_;
   std::unique_ptr<SparseCholesky> chol_;
+  HeldDofSolve held_;  // y = A^-1 b and A^-1 e_c of held DOFs, for the current matrix
   std::string active_ = "jacobi";
   double setup_ms_ = 0;
 };

@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace stc {
@@ -25,11 +26,28 @@ struct SparseCholesky::Impl {
 SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
 SparseCholesky::~SparseCholesky() = default;
 
-SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method)
+SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
+                               CholeskyOrdering ordering)
     : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
   impl_->method = method;
   if (rows_ == 0) return;
-  const Impl::ColMatrix col(a);
+  if (ordering == CholeskyOrdering::kAmd)
+    for (cholmod_common* c : {&impl_->simplicial.cholmod(), &impl_->supernodal.cholmod()}) {
+      c->nmethods = 1;
+      c->method[0].ordering = CHOLMOD_AMD;
+    }
+  // A is symmetric, so its row-major arrays are also its column-major arrays: copied as they
+  // are instead of transposed (CHOLMOD reads the lower triangle: A's upper one, equal to
+  // rounding).
+  Impl::ColMatrix col(a.rows(), a.cols());
+  if (a.isCompressed()) {
+    col.resizeNonZeros(a.nonZeros());
+    std::copy(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1, col.outerIndexPtr());
+    std::copy(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), col.innerIndexPtr());
+    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), col.valuePtr());
+  } else {
+    col = a;
+  }
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
   Eigen::ComputationInfo info;

@@ -120,6 +120,7 @@ class HybridModel {
   TetMesh mesh_;
   Vec3 gravity_ = Vec3::Zero();
   Vector point_loads_;               // 3n, new nodes unloaded
+  Vector condensed_gravity_;         // gravity of part-2 tets (3n at construction)
   std::vector<std::uint8_t> fixed_;  // per node
   ElementStiffnessCache elements_;
   Partition partition_;

@@ -63,6 +63,8 @@ class LinearSolver {
 //   kCholesky: M = P A^-1 P with A factored once per set_matrix (CHOLMOD). The constrained DOFs
 //              are a few contact nodes, so the preconditioned operator is the identity plus a
 //              term of rank <= #constrained DOFs: CG converges in about that many iterations.
+//              Before CG, one direct step solves the held DOFs through the factor and a
+//              capacitance system (docs/DESIGN.md eqs. (24)-(25)): usually the only iteration.
 //              If A cannot be factored even with a tiny diagonal shift (indefinite), that
 //              matrix is solved with Jacobi instead; preconditioner() says which is active.
 enum class CgPreconditioner { kJacobi, kCholesky };
