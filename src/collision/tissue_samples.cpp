@@ -49,8 +49,7 @@ int tet_containing(const TetMesh& mesh, const TetGrid& grid, const Vec3& p) {
   return -1;
 }
 
-std::vector<int> tets_near(const TetMesh& mesh, const TetGrid& grid, const Vec3& p,
-                           double reach) {
+std::vector<int> tets_near(const TetMesh& mesh, const TetGrid& grid, const Vec3& p, double reach) {
   const Vec3 r = Vec3::Constant(reach);
   return grid.query(mesh, p - r, p + r);
 }

@@ -15,9 +15,9 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-constexpr double kReach = 0.25;      // of R: how far ahead of the blade the region must be clear
-constexpr double kLookahead = 0.4;   // of R: the new centre, along the blade's motion
-constexpr double kMinShift = 0.1;    // of R: a smaller move changes nothing
+constexpr double kReach = 0.25;     // of R: how far ahead of the blade the region must be clear
+constexpr double kLookahead = 0.4;  // of R: the new centre, along the blade's motion
+constexpr double kMinShift = 0.1;   // of R: a smaller move changes nothing
 
 TetGrid grid_of(const TetMesh& mesh, const std::vector<std::uint8_t>& include) {
   TetGrid g;
@@ -117,8 +117,8 @@ bool RegionFollower::worth_moving_to(const Vec3& centre) const {
   return (centre - stats_.ball.center).norm() > kMinShift * stats_.ball.radius;
 }
 
-void RegionFollower::start(const HybridModel& from, const Vec3& centre,
-                           std::vector<int> keep_nodes, std::string reason) {
+void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
+                           std::string reason) {
   if (moving()) return;
   requested_at_ = Clock::now();
   stats_.moving = true;

@@ -335,7 +335,7 @@ struct Simulation::Impl {
   // within one element layer of the interface asks for a move around it and waits (the cut
   // waits at the interface). A sweep no ball of radius R around it can hold is cut as far as
   // the region reaches, like a fixed region's.
-  void drain_sweeps(StepStats& s) {
+  void drain_sweeps(StepStats& s, bool wait) {
     const double length = scene.scalpel.blade_length;
     while (!pending_sweeps.empty()) {
       if (follower->moving()) {
@@ -350,7 +350,7 @@ struct Simulation::Impl {
         if (follower->worth_moving_to(centre)) {
           ++sw.moves_tried;
           start_move(centre, "the cut came within one element layer of the interface");
-          if (options.wait_for_region_moves) {  // offline: the sweep waits for nothing
+          if (wait) {  // offline: the sweep waits for nothing
             adopt_moved_region(s, true);
             continue;
           }
@@ -373,7 +373,8 @@ struct Simulation::Impl {
     const Vec3 motion = blade_state == BladeState::kCutting && last_pose
                             ? Vec3(blade->position - last_pose->position)
                             : Vec3::Zero();
-    const Vec3 centre = follower->centre_for(*model, cut_state, follower->edge_points(edge), motion);
+    const Vec3 centre =
+        follower->centre_for(*model, cut_state, follower->edge_points(edge), motion);
     if (follower->worth_moving_to(centre)) start_move(centre, std::move(why));
   }
 
@@ -391,11 +392,13 @@ struct Simulation::Impl {
     settle_region_move();
   }
 
-  // Waits for a running move and swaps it in (offline, or before the mesh or E changes).
+  // Waits for a running move, swaps it in and cuts every waiting sweep (moving the region
+  // again as they need, waiting each time): offline callers, and before the mesh or E changes.
   void settle_region_move() {
-    if (!follower || !follower->moving()) return;
+    if (!follower || (!follower->moving() && pending_sweeps.empty())) return;
     StepStats s;
     adopt_moved_region(s, true);
+    drain_sweeps(s, true);
     ++surface_version;
   }
 
@@ -468,7 +471,7 @@ struct Simulation::Impl {
     if (follower) {
       const auto t0 = Clock::now();
       const double cut_ms = s.cutting_ms + s.assembly_ms;
-      drain_sweeps(s);
+      drain_sweeps(s, options.wait_for_region_moves);
       maybe_move_region(blade);
       s.region_moving = follower->moving();
       s.collision_ms += ms_since(t0) - (s.cutting_ms + s.assembly_ms - cut_ms);
@@ -494,7 +497,8 @@ struct Simulation::Impl {
       }
     }
     last_pose = blade;
-    if (s.cg_iterations > 0 || s.cutting || s.region_moved) ++surface_version;  // the drawn surface changed
+    if (s.cg_iterations > 0 || s.cutting || s.region_moved)
+      ++surface_version;  // the drawn surface changed
     s.step_ms = ms_since(t_step);
     last = s;
     return s;

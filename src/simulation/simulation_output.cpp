@@ -46,12 +46,13 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   if (const RegionMoveStats* m = region_moves()) {  // `follow` region
     std::vector<double> d = m->durations_ms;
     std::sort(d.begin(), d.end());
-    j["region_moves"] = {{"moves", m->moves},
-                         {"failed", m->failed},
-                         {"median_ms", d.empty() ? 0.0 : d[d.size() / 2]},
-                         {"max_ms", m->max_ms},
-                         {"ball_center", {m->ball.center.x(), m->ball.center.y(), m->ball.center.z()}},
-                         {"radius", m->ball.radius}};
+    j["region_moves"] = {
+        {"moves", m->moves},
+        {"failed", m->failed},
+        {"median_ms", d.empty() ? 0.0 : d[d.size() / 2]},
+        {"max_ms", m->max_ms},
+        {"ball_center", {m->ball.center.x(), m->ball.center.y(), m->ball.center.z()}},
+        {"radius", m->ball.radius}};
   }
   j["volume_initial"] = c.volume_initial;
   j["volume_final"] = c.volume_final;

@@ -43,13 +43,13 @@ struct RegionMoveStats {
 // partition, so the swap itself only exchanges pointers.
 struct MovedRegion {
   std::unique_ptr<HybridModel> model;
-  OperationSurface boundary;                 // the new partition's operation surface
-  std::vector<std::uint8_t> cuttable;        // per tet: part 1 of the new partition
-  std::vector<std::uint8_t> locked;          // per node: a node of a condensed tet
-  TetGrid cut_grid;                          // the part-1 tets
-  TetGrid condensed_grid;                    // the part-2 tets
-  Vec3 centre = Vec3::Zero();                // the new ball's centre
-  double ms = 0;                             // worker time
+  OperationSurface boundary;           // the new partition's operation surface
+  std::vector<std::uint8_t> cuttable;  // per tet: part 1 of the new partition
+  std::vector<std::uint8_t> locked;    // per node: a node of a condensed tet
+  TetGrid cut_grid;                    // the part-1 tets
+  TetGrid condensed_grid;              // the part-2 tets
+  Vec3 centre = Vec3::Zero();          // the new ball's centre
+  double ms = 0;                       // worker time
 };
 
 // The cutter's view of a partition (same rule as make_cut_state): only part-1 tets are

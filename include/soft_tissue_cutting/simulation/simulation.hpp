@@ -18,7 +18,7 @@ namespace stc {
 
 class HybridModel;
 struct RegionMoveStats;  // simulation/region_follower.hpp
-struct StepTimes;  // simulation/step_times.hpp
+struct StepTimes;        // simulation/step_times.hpp
 
 struct SimulationOptions {
   std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
@@ -157,7 +157,8 @@ class Simulation {
   const std::vector<double>& tet_size_classes() const;
   // `follow` region: moves so far, their durations, the ball now (nullptr for a fixed region).
   const RegionMoveStats* region_moves() const;
-  // Waits for a running region move and swaps it in (offline callers, tests).
+  // Waits for a running region move, swaps it in and cuts the sweeps that waited for it
+  // (moving again, waiting, as they need): offline callers, tests.
   void settle_region_move();
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;
