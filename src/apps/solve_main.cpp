@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
   try {
     stc::SimulationOptions options;
     options.backend = backend;
+    // A `follow` region's moves are awaited offline (no real time to keep): deterministic.
+    options.wait_for_region_moves = true;
     stc::Simulation sim(stc::load_scene(scene_path), options);
     if (!sim.backend_note().empty())
       std::fprintf(stderr, "tissue solve: %s\n", sim.backend_note().c_str());
@@ -72,7 +74,7 @@ int main(int argc, char** argv) {
       char when[32];
       std::snprintf(when, sizeof when, "t=%.3f", pose.t);
       report_fallback(s, when);
-      if (s.reached_interface)
+      if (s.reached_interface && !s.region_moving)
         std::fprintf(stderr,
                      "tissue solve: t=%.3f: the blade reached the interface of the "
                      "condensed part; cutting stops there\n",

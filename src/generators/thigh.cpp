@@ -69,7 +69,10 @@ TetMesh refine_thigh_operation_region(const TetMesh& tube, const GeneratorParams
   // 2134 tets, and the operation part gets the interior nodes a cut needs (only operation
   // nodes can be duplicated; interface nodes never are).
   const double h = scale / p.resolution;
-  return refine_region(tube, region, 2.5e-7 * h * h * h);
+  // `follow`: the ball goes wherever the blade goes, so the whole tube is refined.
+  OperationRegion refined = region;
+  if (region.follows_blade()) refined.kind = OperationRegion::Kind::kAll;
+  return refine_region(tube, refined, 2.5e-7 * h * h * h);
 }
 
 Scene make_thigh_scene(double resolution) {

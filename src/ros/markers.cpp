@@ -156,7 +156,9 @@ visualization_msgs::MarkerArray operation_region_markers(const OperationRegion& 
   m.pose.orientation.w = 1;
   m.scale.x = 0.0006;  // line width, m
   m.color = rgba(0.3, 0.7, 1.0, 0.8);
-  if (region.kind == OperationRegion::Kind::kSphere) {
+  // `follow`: the ball where it is now (it moves with the blade).
+  if (region.kind == OperationRegion::Kind::kSphere ||
+      region.kind == OperationRegion::Kind::kFollow) {
     const Vec3 c = region.sphere.center;
     const double r = region.sphere.radius;
     const int segments = 64;

@@ -3,6 +3,9 @@
 // while the simulation is busy, and a stalled loop shows up as an ERROR.
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
+#include <algorithm>
+#include <cstdio>
+
 namespace stc {
 namespace ros_io {
 
@@ -28,6 +31,7 @@ void TissueNode::remember_solver_failure(const std::string& why) {
 void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const LoopHealth h = monitor_.health(LoopMonitor::Clock::now());
   std::string backend, renderer, note, failure, solved_by, fallback;
+  std::optional<RegionMoveStats> moves;
   {
     std::lock_guard<std::mutex> lock(info_mutex_);
     backend = backend_;
@@ -36,6 +40,7 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     failure = solver_failure_;
     solved_by = solved_by_;
     fallback = fallback_reason_;
+    moves = region_moves_;
   }
   const double period_ms = 1000.0 / params_.rate;
   std::string summary = h.level == LoopHealth::kOk ? h.summary + " on " + backend : h.summary;
@@ -58,6 +63,22 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("solved by", solved_by);  // cpu when a gl solve fell back
   status.add("fallback reason", fallback);
   status.add("steps", h.steps);
+  if (moves) {  // `follow` operation region (docs/ROS.md "API")
+    std::vector<double> d = moves->durations_ms;
+    std::sort(d.begin(), d.end());
+    status.add("region moves", moves->moves);
+    status.add("region moves failed", moves->failed);
+    status.add("region moving", moves->moving);
+    status.add("region move last (ms)", moves->last_ms);
+    status.add("region move median (ms)", d.empty() ? 0.0 : d[d.size() / 2]);
+    status.add("region move max (ms)", moves->max_ms);
+    status.add("region move wait (ms)", moves->last_wait_ms);
+    char centre[96];
+    std::snprintf(centre, sizeof centre, "%.4f %.4f %.4f", moves->ball.center.x(),
+                  moves->ball.center.y(), moves->ball.center.z());
+    status.add("region centre (m)", std::string(centre));
+    status.add("region move reason", moves->last_reason);
+  }
 }
 
 }  // namespace ros_io

@@ -30,6 +30,7 @@ void TissueNode::publish_step_locked(const StepStats& s, const std::optional<Bla
     std::lock_guard<std::mutex> lock(info_mutex_);
     solved_by_ = s.solved_by;
     fallback_reason_ = s.fallback_reason;
+    if (const RegionMoveStats* m = sim_->region_moves()) region_moves_ = *m;  // `follow`
   }
   wrench_pub_.publish(wrench);
 }

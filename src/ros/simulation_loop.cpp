@@ -26,7 +26,11 @@ void TissueNode::loop() {
       const StepStats s = sim_->step(blade);
       converged = s.converged;
       failure = s.solver_message;
-      if (s.reached_interface)
+      if (s.reached_interface && s.region_moving)
+        ROS_WARN_THROTTLE(2.0,
+                          "the cut waits at the interface while the operation region moves "
+                          "to the blade");
+      else if (s.reached_interface)
         ROS_WARN_THROTTLE(2.0,
                           "the blade reached the interface of the condensed part: cutting "
                           "stops there (the cut stays inside the operation region)");

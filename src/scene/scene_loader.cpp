@@ -65,6 +65,7 @@ class SceneLoader {
     }
     if (root["scalpel"]) load_scalpel(root["scalpel"]);
     if (root["trajectory"]) load_trajectory(root["trajectory"]);
+    if (scene_.operation_region.follows_blade()) place_follow_region();
     if (root["solver"]) load_solver(root["solver"]);
     return std::move(scene_);
   }
@@ -252,7 +253,7 @@ class SceneLoader {
     }
   }
 
-  // ---- operation region: `all`, `none`, {sphere: ...} or {box: ...}
+  // ---- operation region: `all`, `none`, {sphere: ...}, {box: ...} or {follow: {radius}}
   void load_region(const YAML::Node& n) {
     OperationRegion& r = scene_.operation_region;
     if (n.IsScalar()) {
@@ -263,12 +264,22 @@ class SceneLoader {
         r.kind = OperationRegion::Kind::kNone;
       else
         f_.fail(n, "operation_region",
-                "expected all, none, {sphere: ...} or {box: ...}, got '" + v + "'");
+                "expected all, none, {sphere: ...}, {box: ...} or {follow: {radius: r}}, got '" +
+                    v + "'");
       return;
     }
-    f_.check_map(n, "operation_region", {"sphere", "box"});
-    if (f_.count_present(n, {"sphere", "box"}) != 1)
-      f_.fail(n, "operation_region", "needs exactly one of `sphere` or `box`");
+    f_.check_map(n, "operation_region", {"sphere", "box", "follow"});
+    if (f_.count_present(n, {"sphere", "box", "follow"}) != 1)
+      f_.fail(n, "operation_region", "needs exactly one of `sphere`, `box` or `follow`");
+    if (n["follow"]) {
+      // A ball around the blade; where it starts is placed once the trajectory is read.
+      const YAML::Node& fo = n["follow"];
+      f_.check_map(fo, "operation_region.follow", {"radius"});
+      if (!fo["radius"]) f_.fail(fo, "operation_region.follow.radius", "missing");
+      r.kind = OperationRegion::Kind::kFollow;
+      r.sphere.radius = f_.positive(fo["radius"], "operation_region.follow.radius");
+      return;
+    }
     if (n["sphere"]) {
       r.kind = OperationRegion::Kind::kSphere;
       r.sphere = sphere(n["sphere"], "operation_region.sphere");
@@ -285,6 +296,24 @@ class SceneLoader {
     if (!any)
       f_.fail(n, "operation_region",
               "contains no element centroid (use `none` for no operation part)");
+  }
+
+  // `follow` before any blade pose: centred on the first trajectory pose (the blade tip where
+  // the scripted scalpel starts), else on the centre of the mesh's bounding box. It may hold
+  // no tet at first: the simulation moves it to the blade as soon as the blade nears tissue
+  // outside it (docs/SCENE.md "Scene file").
+  void place_follow_region() {
+    Sphere& ball = scene_.operation_region.sphere;
+    if (!scene_.trajectory.empty()) {
+      ball.center = scene_.trajectory.front().position;
+      return;
+    }
+    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+    for (const Vec3& x : scene_.mesh.nodes) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+    ball.center = scene_.mesh.nodes.empty() ? Vec3::Zero() : Vec3(0.5 * (lo + hi));
   }
 
   void load_scalpel(const YAML::Node& n) {

@@ -32,6 +32,7 @@ bool OperationRegion::contains(const Vec3& centroid) const {
     case Kind::kNone:
       return false;
     case Kind::kSphere:
+    case Kind::kFollow:  // the ball where it is now
       return sphere.contains(centroid);
     case Kind::kBox:
       return box.contains(centroid);

@@ -77,7 +77,30 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   t0 = Clock::now();
   elements_ = ElementStiffnessCache(mesh_, scene.material);
   timings_["element_stiffness"] = ms_since(t0);
+  condense_and_assemble(start);
+}
 
+HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
+                         std::unique_ptr<LinearSolver> solver)
+    : mesh_(from.mesh_),
+      gravity_(from.gravity_),
+      point_loads_(from.point_loads_),
+      fixed_(from.fixed_),
+      elements_(from.elements_),  // at the current E: the new condensation is at scale 1
+      solver_(std::move(solver)),
+      settings_(from.settings_) {
+  if (!solver_) throw std::invalid_argument("HybridModel: no linear solver");
+  if (operation_tet.size() != static_cast<size_t>(mesh_.num_tets()))
+    throw std::invalid_argument("HybridModel: one operation label per tet expected");
+  const auto start = Clock::now();
+  const auto t0 = Clock::now();
+  partition_ = partition_from_labels(mesh_, std::move(operation_tet));
+  timings_["partition"] = ms_since(t0);
+  timings_["element_stiffness"] = 0;  // re-used from `from`
+  condense_and_assemble(start);
+}
+
+void HybridModel::condense_and_assemble(Clock::time_point start) {
   // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
   // below), so only f_N reaches the condensation.
   condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
@@ -91,7 +114,7 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   timings_["condensation_products"] = condensed_.product_ms;
 
   u_ = Vector::Zero(3 * mesh_.num_nodes());
-  t0 = Clock::now();
+  const auto t0 = Clock::now();
   rebuild_hybrid_system();
   timings_["hybrid_assembly"] = ms_since(t0);
   timings_["total"] = ms_since(start);
@@ -195,6 +218,14 @@ const Vector& HybridModel::displacement() const {
 }
 
 void HybridModel::recover_interior() { displacement(); }
+
+void HybridModel::set_displacement(const Vector& u) {
+  if (u.size() != u_.size())
+    throw std::invalid_argument("HybridModel::set_displacement: size does not match the mesh");
+  u_ = u;
+  system_changed_ = true;  // the next solve runs, warm from u
+  condensed_stale_ = true;
+}
 
 void HybridModel::reset_displacement() {
   u_.setZero();

@@ -10,11 +10,13 @@
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
+#include "soft_tissue_cutting/simulation/region_follower.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <stdexcept>
 
 namespace stc {
@@ -62,6 +64,16 @@ struct Simulation::Impl {
   SimulationOptions options;
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
+  // `follow` region only (region_follower.hpp); declared after `model`, so it is destroyed
+  // first and its worker, which reads the model, has ended before the model goes.
+  std::unique_ptr<RegionFollower> follower;
+  // `follow`: the blade's sweeps not cut yet (they wait while the region moves), in order.
+  struct Sweep {
+    BladePose from, to;
+    int moves_tried = 0;
+  };
+  std::deque<Sweep> pending_sweeps;
+  std::vector<int> held_piece_nodes;  // `follow`: every node of a held free piece
   CutState cut_state;
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
@@ -111,6 +123,9 @@ struct Simulation::Impl {
   }
 
   void start() {
+    follower.reset();  // waits for a running move: it reads the model replaced below
+    pending_sweeps.clear();
+    held_piece_nodes.clear();
     scene = initial;
     refuse_floating_pieces();
     model = std::make_unique<HybridModel>(scene, make_solver());
@@ -122,7 +137,19 @@ struct Simulation::Impl {
     cut_state = make_cut_state(model->mesh_for_cutting(), locked, p.operation_tet);
     cut_spacing = median_operation_edge(scene.mesh, p.operation_tet);
     anchored = model->fixed_nodes();
-    for (int i : p.interface) anchored[static_cast<size_t>(i)] = 1;
+    if (scene.operation_region.follows_blade()) {
+      // The ball goes anywhere: the blade is sampled at half the median edge of the whole
+      // mesh. A moved region condenses tissue the blade has cut, so a piece is anchored by its
+      // fixed (or held) nodes only, never by interface nodes.
+      cut_spacing =
+          median_operation_edge(scene.mesh, std::vector<std::uint8_t>(scene.mesh.tets.size(), 1));
+      follower = std::make_unique<RegionFollower>(scene.operation_region.sphere, *model,
+                                                  0.5 * cut_spacing);
+    } else {
+      // A fixed region's part 2 is uncut and every piece of it reaches an interface or fixed
+      // node: interface nodes anchor.
+      for (int i : p.interface) anchored[static_cast<size_t>(i)] = 1;
+    }
     held.clear();
     free_pieces_held = 0;
     blade_state = BladeState::kFree;
@@ -202,6 +229,7 @@ struct Simulation::Impl {
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
   // it is.
   void hold_free_pieces() {
+    if (follower) return hold_free_pieces_anywhere();
     // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
     // (its condensation is nonsingular), and those are anchored.
     const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
@@ -215,6 +243,163 @@ struct Simulation::Impl {
                    "soft_tissue_cutting: a piece of %zu tets was cut free; it is held in place\n",
                    piece.tets.size());
     }
+  }
+
+  // `follow`: a piece may reach into the condensed part (cut there before a move), so pieces
+  // are looked for in the whole mesh. Its O and I nodes are held now; its condensed nodes
+  // follow them through the condensation, and every later move keeps the whole piece in
+  // part 1, where its nodes are held too (adopt_moved_region).
+  void hold_free_pieces_anywhere() {
+    const Partition& p = model->partition();
+    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+      for (int n : piece.nodes) {
+        const NodeSet set = p.node_set[static_cast<size_t>(n)];
+        if (set == NodeSet::kOperation || set == NodeSet::kInterface)
+          held[n] = model->operation_displacement().segment<3>(3 * n);
+        anchored[static_cast<size_t>(n)] = 1;
+        held_piece_nodes.push_back(n);
+      }
+      ++free_pieces_held;
+      std::fprintf(stderr,
+                   "soft_tissue_cutting: a piece of %zu tets was cut free; it is held in place\n",
+                   piece.tets.size());
+    }
+  }
+
+  // ---- `follow`: the operation region moves with the blade (region_follower.hpp)
+
+  // Nodes that must stay O or I in a moved region: those the blade or a holder imposes.
+  std::vector<int> imposed_nodes() const {
+    std::vector<int> keep = held_piece_nodes;
+    for (const auto& h : held) keep.push_back(h.first);
+    for (const EdgeHeldNode& e : contact.edge_nodes()) keep.push_back(e.node);
+    if (contact.tip_anchor())
+      for (int n : contact.tip_anchor()->nodes) keep.push_back(n);
+    return keep;
+  }
+
+  void start_move(const Vec3& centre, std::string why) {
+    follower->start(*model, centre, imposed_nodes(), std::move(why));
+  }
+
+  bool operation_or_interface(const HybridModel& m, int n) const {
+    const NodeSet set = m.partition().node_set[static_cast<size_t>(n)];
+    return set == NodeSet::kOperation || set == NodeSet::kInterface;
+  }
+
+  // At a step boundary: the moved region's model replaces the old one once the worker has
+  // built it (offline, wait_for_region_moves: at the first step after the request, waiting
+  // for it). The swap changes no displacement (region_follower.hpp).
+  void adopt_moved_region(StepStats& s, bool wait) {
+    if (!follower || !follower->moving()) return;
+    if (!wait && !follower->ready()) {
+      s.region_moving = true;
+      return;
+    }
+    std::optional<MovedRegion> moved = follower->take();
+    if (!moved) return;
+    HybridModel& next = *moved->model;
+    for (const auto& h : held)  // a held node must stay imposable (the worker kept them)
+      if (!operation_or_interface(next, h.first)) {
+        follower->dropped();
+        return;
+      }
+    next.set_displacement(model->displacement());  // S and Q recovered: the whole state
+    next.set_cg_settings(model->cg_settings());
+    if (backend == "gl") next.set_solver(make_solver());
+    model = std::move(moved->model);
+    apply_partition_to_cut_state(*moved, cut_state);
+    boundary = std::move(moved->boundary);
+    follower->adopted(*moved);
+    scene.operation_region.sphere = follower->ball();
+    // Nodes the blade took since the request that the new region condenses: let go (it
+    // takes them again next step if it still presses there).
+    bool release = false;
+    for (const EdgeHeldNode& e : contact.edge_nodes())
+      release = release || !operation_or_interface(*model, e.node);
+    if (contact.tip_anchor())
+      for (int n : contact.tip_anchor()->nodes)
+        release = release || !operation_or_interface(*model, n);
+    if (release) contact.release();
+    // Nodes of held pieces that were condensed are part 1 now: held where they are.
+    const Vector& u = model->operation_displacement();
+    for (int n : held_piece_nodes)
+      if (!held.count(n) && operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
+    const Partition& p = model->partition();
+    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
+                       p.operation_tet, displacements());
+    s.region_moved = true;
+  }
+
+  // Cuts the waiting sweeps in order while each fits the region; a sweep that would come
+  // within one element layer of the interface asks for a move around it and waits (the cut
+  // waits at the interface). A sweep no ball of radius R around it can hold is cut as far as
+  // the region reaches, like a fixed region's.
+  void drain_sweeps(StepStats& s, bool wait) {
+    const double length = scene.scalpel.blade_length;
+    while (!pending_sweeps.empty()) {
+      if (follower->moving()) {
+        s.reached_interface = true;  // the cut waits at the interface for the move
+        return;
+      }
+      Sweep& sw = pending_sweeps.front();
+      const BladeEdge a = blade_edge(sw.from, length), b = blade_edge(sw.to, length);
+      if (sw.moves_tried < 2 && !follower->sweep_fits(*model, cut_state, a, b)) {
+        const Vec3 centre = follower->centre_for(*model, cut_state, follower->sweep_points(a, b),
+                                                 sw.to.position - sw.from.position);
+        if (follower->worth_moving_to(centre)) {
+          ++sw.moves_tried;
+          start_move(centre, "the cut came within one element layer of the interface");
+          if (wait) {  // offline: the sweep waits for nothing
+            adopt_moved_region(s, true);
+            continue;
+          }
+          s.reached_interface = true;
+          return;
+        }
+      }
+      cut(sw.from, sw.to, s);
+      pending_sweeps.pop_front();
+    }
+  }
+
+  // A blade near tissue the region does not hold clear of its interface: a move around it.
+  void maybe_move_region(const std::optional<BladePose>& blade) {
+    if (!blade || follower->moving() || !pending_sweeps.empty()) return;
+    const BladeEdge edge = blade_edge(*blade, scene.scalpel.blade_length);
+    std::string why = follower->edge_clearance(*model, cut_state, edge);
+    if (why.empty()) return;
+    // Ahead along the blade's motion while it cuts; around it while it presses.
+    const Vec3 motion = blade_state == BladeState::kCutting && last_pose
+                            ? Vec3(blade->position - last_pose->position)
+                            : Vec3::Zero();
+    const Vec3 centre =
+        follower->centre_for(*model, cut_state, follower->edge_points(edge), motion);
+    if (follower->worth_moving_to(centre)) start_move(centre, std::move(why));
+  }
+
+  // `follow`, ~cut paths: the region moves (waiting for it) to hold each sweep before it is
+  // cut, so a path longer than the region cuts end to end.
+  void move_region_for_path_sweep(const BladePose& from, const BladePose& to) {
+    settle_region_move();
+    const double length = scene.scalpel.blade_length;
+    const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
+    if (follower->sweep_fits(*model, cut_state, a, b)) return;
+    const Vec3 centre = follower->centre_for(*model, cut_state, follower->sweep_points(a, b),
+                                             to.position - from.position);
+    if (!follower->worth_moving_to(centre)) return;
+    start_move(centre, "a ~cut path left the region");
+    settle_region_move();
+  }
+
+  // Waits for a running move, swaps it in and cuts every waiting sweep (moving the region
+  // again as they need, waiting each time): offline callers, and before the mesh or E changes.
+  void settle_region_move() {
+    if (!follower || (!follower->moving() && pending_sweeps.empty())) return;
+    StepStats s;
+    adopt_moved_region(s, true);
+    drain_sweeps(s, true);
+    ++surface_version;
   }
 
   // O and I current, S as last recovered: the tree's operation triangles (the only ones
@@ -234,7 +419,9 @@ struct Simulation::Impl {
 
   bool edge_inside_tissue(const BladeEdge& edge) const {
     return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length, [&](const Vec3& p) {
-      return inside_rest_tissue(model->mesh(), cut_state, p);
+      // `follow`: the condensed part is tissue too (the blade may wait there for a move).
+      return follower ? follower->inside_tissue(*model, cut_state, p)
+                      : inside_rest_tissue(model->mesh(), cut_state, p);
     });
   }
 
@@ -242,6 +429,7 @@ struct Simulation::Impl {
     const auto t_step = Clock::now();
     StepStats s;
     s.step = ++steps;
+    adopt_moved_region(s, options.wait_for_region_moves);
     ImposedDisplacements imposed;
     const double length = scene.scalpel.blade_length;
     if (!blade) {
@@ -259,7 +447,12 @@ struct Simulation::Impl {
         for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
         const bool retracing =
             last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
-        if (last_pose && !retracing) cut(*last_pose, *blade, s);
+        if (last_pose && !retracing) {
+          if (follower)
+            pending_sweeps.push_back({*last_pose, *blade});
+          else
+            cut(*last_pose, *blade, s);
+        }
         stroke.push_back(*blade);
         if (retracing || !edge_inside_tissue(edge)) {
           blade_state = BladeState::kFree;
@@ -274,6 +467,14 @@ struct Simulation::Impl {
         blade_state = contact.empty() ? BladeState::kFree : BladeState::kPressing;
       }
       s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
+    }
+    if (follower) {
+      const auto t0 = Clock::now();
+      const double cut_ms = s.cutting_ms + s.assembly_ms;
+      drain_sweeps(s, options.wait_for_region_moves);
+      maybe_move_region(blade);
+      s.region_moving = follower->moving();
+      s.collision_ms += ms_since(t0) - (s.cutting_ms + s.assembly_ms - cut_ms);
     }
     s.converged = solve(imposed, s);
     if (!imposed.empty()) {
@@ -296,7 +497,8 @@ struct Simulation::Impl {
       }
     }
     last_pose = blade;
-    if (s.cg_iterations > 0 || s.cutting) ++surface_version;  // the drawn surface changed
+    if (s.cg_iterations > 0 || s.cutting || s.region_moved)
+      ++surface_version;  // the drawn surface changed
     s.step_ms = ms_since(t_step);
     last = s;
     return s;
@@ -371,6 +573,7 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
         cut.crossed = cut.crossed || inside_rest_tissue(mesh(), impl_->cut_state, x);
     }
     StepStats s;
+    if (impl_->follower) impl_->move_region_for_path_sweep(from, to);
     changed |= impl_->cut(from, to, s);
     cut.tets_split += s.tets_split;
     cut.nodes_added += s.nodes_added;
@@ -417,6 +620,7 @@ bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
 void Simulation::set_young_modulus(double pascal) {
   if (!(pascal > 0)) throw std::invalid_argument("young_modulus must be > 0");
+  impl_->settle_region_move();  // the worker reads the element matrices
   impl_->scene.material.young_modulus = pascal;
   impl_->model->set_young_modulus(pascal);
 }
@@ -479,6 +683,10 @@ const std::map<std::string, double>& Simulation::precompute_timings_ms() const {
 }
 
 const HybridModel& Simulation::model() const { return *impl_->model; }
+const RegionMoveStats* Simulation::region_moves() const {
+  return impl_->follower ? &impl_->follower->stats() : nullptr;
+}
+void Simulation::settle_region_move() { impl_->settle_region_move(); }
 const std::vector<double>& Simulation::tet_size_classes() const {
   return impl_->cut_state.origin_volume;
 }

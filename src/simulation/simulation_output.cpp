@@ -1,10 +1,12 @@
 // The offline outputs of docs/SCENE.md "Offline run": the VTK state and the JSON statistics.
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
+#include "soft_tissue_cutting/simulation/region_follower.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
 
@@ -41,6 +43,17 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   j["cuts"] = c.cuts;
   j["tets_split"] = c.tets_split;
   j["free_pieces_held"] = c.free_pieces_held;
+  if (const RegionMoveStats* m = region_moves()) {  // `follow` region
+    std::vector<double> d = m->durations_ms;
+    std::sort(d.begin(), d.end());
+    j["region_moves"] = {
+        {"moves", m->moves},
+        {"failed", m->failed},
+        {"median_ms", d.empty() ? 0.0 : d[d.size() / 2]},
+        {"max_ms", m->max_ms},
+        {"ball_center", {m->ball.center.x(), m->ball.center.y(), m->ball.center.z()}},
+        {"radius", m->ball.radius}};
+  }
   j["volume_initial"] = c.volume_initial;
   j["volume_final"] = c.volume_final;
   j["cg_iterations"] = c.cg_iterations_total;  // the whole run: initial equilibrium + steps

@@ -19,6 +19,7 @@
 #include "soft_tissue_cutting/ros/loop_monitor.hpp"
 #include "soft_tissue_cutting/ros/node_params.hpp"
 #include "soft_tissue_cutting/ros/pose_input.hpp"
+#include "soft_tissue_cutting/simulation/region_follower.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -147,9 +148,10 @@ class TissueNode {
   // What /diagnostics says about the backend: copied under sim_mutex_, read under info_mutex_.
   std::mutex info_mutex_;
   std::string backend_, renderer_, backend_note_;
-  std::string solver_failure_;               // why the last non-converged solve failed
-  std::string solved_by_, fallback_reason_;  // the last step's (cpu when a gl solve fell back)
-  std::uint64_t steps_ = 0;                  // loop thread
+  std::string solver_failure_;                   // why the last non-converged solve failed
+  std::string solved_by_, fallback_reason_;      // the last step's (cpu when a gl solve fell back)
+  std::optional<RegionMoveStats> region_moves_;  // `follow` region: as of the last step
+  std::uint64_t steps_ = 0;                      // loop thread
 
   // Display bookkeeping (under sim_mutex_).
   std::uint64_t published_version_ = 0;

@@ -47,10 +47,15 @@ struct Material {
 };
 
 struct OperationRegion {
-  enum class Kind { kSphere, kBox, kAll, kNone } kind = Kind::kAll;
+  // kFollow: a ball of radius `sphere.radius` around the blade that moves with it (the model
+  // is re-partitioned and re-condensed around the blade, simulation/region_follower.hpp).
+  // `sphere` holds where the ball starts: the first trajectory pose's tip, or the centre of
+  // the mesh's bounding box when the scene has no trajectory (docs/SCENE.md "Scene file").
+  enum class Kind { kSphere, kBox, kAll, kNone, kFollow } kind = Kind::kAll;
   Sphere sphere;
   Box box;
   bool contains(const Vec3& centroid) const;
+  bool follows_blade() const { return kind == Kind::kFollow; }
 };
 
 struct ScalpelParams {

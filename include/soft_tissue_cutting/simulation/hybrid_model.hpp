@@ -17,6 +17,7 @@
 #include "soft_tissue_cutting/scene/scene.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
@@ -42,6 +43,14 @@ class HybridModel {
   // Throws std::runtime_error if part 2 cannot be condensed (singular K2_NN).
   explicit HybridModel(const Scene& scene,
                        std::unique_ptr<LinearSolver> solver = make_cpu_solver());
+  // The same tissue as `from` (its current mesh with every cut, loads, fixed nodes, material
+  // and element matrices, re-used as they are), re-partitioned: part 1 = the tets with
+  // operation_tet[t] != 0, part 2 condensed afresh (a condensed part may hold cut geometry).
+  // Reads only what solve() never writes (mesh, loads, fixed nodes, element matrices), so it
+  // may run on a worker thread while `from` keeps solving (simulation/region_follower.hpp).
+  // Starts at zero displacement: set_displacement() hands the current state over.
+  HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
+              std::unique_ptr<LinearSolver> solver = make_cpu_solver());
   ~HybridModel();
   HybridModel(const HybridModel&) = delete;
   HybridModel& operator=(const HybridModel&) = delete;
@@ -69,6 +78,9 @@ class HybridModel {
   void recover_interior();
   // How many recoveries of u_S, u_Q ran (for tests and benchmarks).
   long recoveries() const { return recoveries_; }
+  // Takes over a displacement of the same mesh (3n, e.g. of the model this one replaces): the
+  // next solve runs, warm from it.
+  void set_displacement(const Vector& u);
   // Zero displacement everywhere (the next solve starts cold).
   void reset_displacement();
 
@@ -115,6 +127,7 @@ class HybridModel {
   const std::vector<std::uint8_t>& fixed_nodes() const { return fixed_; }
 
  private:
+  void condense_and_assemble(std::chrono::steady_clock::time_point start);
   void rebuild_hybrid_system();
 
   TetMesh mesh_;

@@ -17,10 +17,15 @@
 namespace stc {
 
 class HybridModel;
-struct StepTimes;  // simulation/step_times.hpp
+struct RegionMoveStats;  // simulation/region_follower.hpp
+struct StepTimes;        // simulation/step_times.hpp
 
 struct SimulationOptions {
   std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
+  // `follow` region: a move requested at one step is awaited at the start of the next
+  // (offline: deterministic, every run moves at the same steps). Off (online), the old model
+  // runs until the worker has finished and the loop never blocks.
+  bool wait_for_region_moves = false;
 };
 
 // Stage timings and outcome of one step.
@@ -44,6 +49,9 @@ struct StepStats {
   int tets_split = 0;              // this step
   int nodes_added = 0;             // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
+  // `follow` region: a re-condensation runs on the worker after this step (the cut waits),
+  // or this step swapped the moved region's model in (region_follower.hpp).
+  bool region_moving = false, region_moved = false;
   double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
   double step_ms = 0;
 };
@@ -147,6 +155,11 @@ class Simulation {
   // Per tet: the volume of the input tet it descends from (its size class, docs/SCENE.md "Cut
   // invariants").
   const std::vector<double>& tet_size_classes() const;
+  // `follow` region: moves so far, their durations, the ball now (nullptr for a fixed region).
+  const RegionMoveStats* region_moves() const;
+  // Waits for a running region move, swaps it in and cuts the sweeps that waited for it
+  // (moving again, waiting, as they need): offline callers, tests.
+  void settle_region_move();
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;
 

@@ -1,0 +1,190 @@
+#include "soft_tissue_cutting/simulation/region_follower.hpp"
+
+#include "soft_tissue_cutting/collision/tissue_samples.hpp"
+#include "soft_tissue_cutting/partition/follow_region.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+
+namespace stc {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr double kReach = 0.25;     // of R: how far ahead of the blade the region must be clear
+constexpr double kLookahead = 0.4;  // of R: the new centre, along the blade's motion
+constexpr double kMinShift = 0.1;   // of R: a smaller move changes nothing
+
+TetGrid grid_of(const TetMesh& mesh, const std::vector<std::uint8_t>& include) {
+  TetGrid g;
+  g.build(mesh, include);
+  return g;
+}
+
+}  // namespace
+
+void apply_partition_to_cut_state(MovedRegion& moved, CutState& state) {
+  state.cuttable = std::move(moved.cuttable);
+  state.locked = std::move(moved.locked);
+  state.grid = std::move(moved.cut_grid);
+}
+
+RegionFollower::RegionFollower(const Sphere& ball, const HybridModel& model, double spacing)
+    : spacing_(spacing) {
+  stats_.ball = ball;
+  std::vector<std::uint8_t> condensed(model.partition().operation_tet.size());
+  for (size_t t = 0; t < condensed.size(); ++t) condensed[t] = !model.partition().operation_tet[t];
+  condensed_grid_ = grid_of(model.mesh(), condensed);
+}
+
+RegionFollower::~RegionFollower() { cancel(); }
+
+bool RegionFollower::inside_tissue(const HybridModel& model, const CutState& cut,
+                                   const Vec3& p) const {
+  return tet_containing(model.mesh(), cut.grid, p) >= 0 ||
+         tet_containing(model.mesh(), condensed_grid_, p) >= 0;
+}
+
+bool RegionFollower::near_tissue(const HybridModel& model, const CutState& cut, const Vec3& p,
+                                 double reach) const {
+  return !tets_near(model.mesh(), cut.grid, p, reach).empty() ||
+         !tets_near(model.mesh(), condensed_grid_, p, reach).empty();
+}
+
+bool RegionFollower::clear_at(const HybridModel& model, const CutState& cut, const Vec3& p,
+                              double reach) const {
+  if (!tets_near(model.mesh(), condensed_grid_, p, reach).empty()) return false;
+  const Partition& part = model.partition();
+  for (int t : tets_near(model.mesh(), cut.grid, p, reach)) {
+    if (!cut.cuttable[static_cast<size_t>(t)]) return false;
+    for (int v : model.mesh().tets[static_cast<size_t>(t)])
+      if (part.node_set[static_cast<size_t>(v)] != NodeSet::kOperation) return false;
+  }
+  return true;
+}
+
+std::vector<Vec3> RegionFollower::edge_points(const BladeEdge& edge) const {
+  return edge_samples(edge, spacing_);
+}
+
+std::vector<Vec3> RegionFollower::sweep_points(const BladeEdge& a, const BladeEdge& b) const {
+  return sweep_samples(a, b, spacing_);
+}
+
+bool RegionFollower::sweep_fits(const HybridModel& model, const CutState& cut, const BladeEdge& a,
+                                const BladeEdge& b) const {
+  // Every point of the swept surface is within `spacing` of a sample, so the tets it meets
+  // are among those near the samples.
+  for (const Vec3& p : sweep_points(a, b))
+    if (!clear_at(model, cut, p, spacing_)) return false;
+  return true;
+}
+
+std::string RegionFollower::edge_clearance(const HybridModel& model, const CutState& cut,
+                                           const BladeEdge& edge) const {
+  const double reach = spacing_ + kReach * stats_.ball.radius;
+  for (const Vec3& p : edge_points(edge)) {
+    if (!tets_near(model.mesh(), condensed_grid_, p, spacing_).empty())
+      return "the blade reached condensed tissue";
+    if (!clear_at(model, cut, p, reach))
+      return "the blade is within one element layer (plus look-ahead) of the interface";
+  }
+  return "";
+}
+
+Vec3 RegionFollower::centre_for(const HybridModel& model, const CutState& cut,
+                                const std::vector<Vec3>& points, const Vec3& motion) const {
+  Vec3 sum = Vec3::Zero();
+  int n = 0;
+  for (double reach : {spacing_, spacing_ + kReach * stats_.ball.radius}) {
+    for (const Vec3& p : points)
+      if (near_tissue(model, cut, p, reach)) {
+        sum += p;
+        ++n;
+      }
+    if (n > 0) break;
+  }
+  Vec3 centre = n > 0 ? Vec3(sum / n) : points.front();
+  if (motion.norm() > 0) centre += kLookahead * stats_.ball.radius * motion.normalized();
+  return centre;
+}
+
+bool RegionFollower::worth_moving_to(const Vec3& centre) const {
+  return (centre - stats_.ball.center).norm() > kMinShift * stats_.ball.radius;
+}
+
+void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
+                           std::string reason) {
+  if (moving()) return;
+  requested_at_ = Clock::now();
+  stats_.moving = true;
+  stats_.last_reason = std::move(reason);
+  const Sphere ball{centre, stats_.ball.radius};
+  // The second core: the old model keeps solving on the caller's thread meanwhile.
+  work_ = std::async(std::launch::async, [&from, ball, keep = std::move(keep_nodes)]() {
+    const auto t0 = Clock::now();
+    MovedRegion r;
+    r.centre = ball.center;
+    r.model = std::make_unique<HybridModel>(from, follow_region_labels(from.mesh(), ball, keep));
+    const TetMesh& mesh = r.model->mesh();
+    const Partition& p = r.model->partition();
+    r.boundary.init(mesh, p.operation_tet);
+    r.cuttable = p.operation_tet;
+    r.locked.assign(mesh.nodes.size(), 0);
+    std::vector<std::uint8_t> condensed(p.operation_tet.size(), 0);
+    for (int t : p.condensed_tets) {
+      condensed[static_cast<size_t>(t)] = 1;
+      for (int v : mesh.tets[static_cast<size_t>(t)]) r.locked[static_cast<size_t>(v)] = 1;
+    }
+    r.cut_grid = grid_of(mesh, r.cuttable);
+    r.condensed_grid = grid_of(mesh, condensed);
+    r.ms = ms_since(t0);
+    return r;
+  });
+}
+
+bool RegionFollower::ready() const {
+  return work_.valid() && work_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+
+std::optional<MovedRegion> RegionFollower::take() {
+  if (!work_.valid()) return std::nullopt;
+  stats_.moving = false;
+  try {
+    MovedRegion r = work_.get();
+    stats_.last_ms = r.ms;
+    stats_.max_ms = std::max(stats_.max_ms, r.ms);
+    stats_.total_ms += r.ms;
+    stats_.durations_ms.push_back(r.ms);
+    return r;
+  } catch (const std::exception& e) {
+    ++stats_.failed;
+    std::fprintf(stderr, "soft_tissue_cutting: the operation region could not move: %s\n",
+                 e.what());
+    return std::nullopt;
+  }
+}
+
+void RegionFollower::adopted(MovedRegion& moved) {
+  ++stats_.moves;
+  stats_.ball.center = moved.centre;
+  stats_.last_wait_ms = ms_since(requested_at_);
+  condensed_grid_ = std::move(moved.condensed_grid);
+}
+
+void RegionFollower::dropped() { ++stats_.failed; }
+
+void RegionFollower::cancel() {
+  if (!work_.valid()) return;
+  try {
+    work_.get();
+  } catch (...) {  // dropped anyway
+  }
+  stats_.moving = false;
+}
+
+}  // namespace stc

@@ -1,0 +1,345 @@
+// The operation region that follows the scalpel (`operation_region: {follow: {radius}}`):
+// re-partitioning is exact (the moved model solves the same loads and contacts to the same
+// displacement, cut tets condensed with the rest), and a 10 cm stroke across the thigh and a
+// TetGen liver, crossing several region moves, cuts continuously, keeps docs/SCENE.md "Cut
+// invariants" after every step and equals the full model at the end.
+#include "follow_stroke_util.hpp"
+
+#include "soft_tissue_cutting/collision/tissue_samples.hpp"
+#include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/partition/follow_region.hpp"
+#include "soft_tissue_cutting/scene/scene_loader.hpp"
+#include "soft_tissue_cutting/simulation/region_follower.hpp"
+
+#include "test_io_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+namespace stc {
+namespace {
+
+// The scene key: a radius > 0 and finite, one clear line otherwise; the ball starts at the
+// first trajectory pose's tip (else the centre of the mesh's bounding box).
+TEST(FollowRegion, SceneKeyParsedWithClearErrors) {
+  test::TempDir dir;
+  const std::string head =
+      "mesh: {generator: {type: box, size: [0.1, 0.02, 0.02], cells: [10, 2, 2]}}\n"
+      "fixed: [{box: {min: [-1, -1, -1], max: [0.001, 1, 1]}}]\n";
+  const Scene ok = load_scene(test::write_file(
+      dir.file("ok.yaml"), head + "operation_region: {follow: {radius: 0.03}}\n"
+                                  "trajectory: [{t: 0, position: [0.05, 0.03, 0.01]}]\n"));
+  EXPECT_TRUE(ok.operation_region.follows_blade());
+  EXPECT_DOUBLE_EQ(ok.operation_region.sphere.radius, 0.03);
+  EXPECT_LT((ok.operation_region.sphere.center - Vec3(0.05, 0.03, 0.01)).norm(), 1e-15);
+  const Scene no_traj = load_scene(
+      test::write_file(dir.file("nt.yaml"), head + "operation_region: {follow: {radius: 0.03}}\n"));
+  EXPECT_LT((no_traj.operation_region.sphere.center - Vec3(0.05, 0.01, 0.01)).norm(), 1e-12);
+  auto error = [&](const std::string& region) {
+    try {
+      load_scene(
+          test::write_file(dir.file("bad.yaml"), head + "operation_region: " + region + "\n"));
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  EXPECT_NE(error("{follow: {radius: 0}}").find("operation_region.follow.radius: must be > 0"),
+            std::string::npos);
+  EXPECT_NE(error("{follow: {radius: -1}}").find("must be > 0"), std::string::npos);
+  EXPECT_NE(error("{follow: {radius: .inf}}").find("finite"), std::string::npos);
+  EXPECT_NE(error("{follow: {radius: .nan}}").find("finite"), std::string::npos);
+  EXPECT_NE(error("{follow: {}}").find("operation_region.follow.radius: missing"),
+            std::string::npos);
+  EXPECT_NE(error("{follow: {radius: 0.02, centre: [0, 0, 0]}}").find("unknown key"),
+            std::string::npos);
+  EXPECT_NE(error("{follow: 0.02}").find("operation_region.follow"), std::string::npos);
+  EXPECT_NE(
+      error("{follow: {radius: 0.02}, sphere: {center: [0, 0, 0], radius: 1}}").find("exactly one"),
+      std::string::npos);
+}
+
+// A follow scene runs offline like `tissue solve` does and reports its moves.
+TEST(FollowRegion, FollowSceneRunsAndReportsMoves) {
+  Scene scene = make_thigh_scene();
+  scene.operation_region.kind = OperationRegion::Kind::kFollow;
+  scene.operation_region.sphere.radius = 0.02;
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation sim(scene, offline);
+  ASSERT_NE(sim.region_moves(), nullptr);
+  // Press on the outer wall away from the initial ball: the region comes to the blade.
+  const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  std::vector<BladePose> poses;
+  const Vec3 far(0.06 * std::cos(1.2), 0.06 * std::sin(1.2), 0.03);
+  const Vec3 out = far * (0.07 / 0.06);
+  test::append_line(poses, out, far * (0.055 / 0.06), 10, q);
+  for (const BladePose& p : poses) EXPECT_TRUE(sim.step(p).converged);
+  sim.step(std::nullopt);
+  EXPECT_GE(sim.region_moves()->moves, 1);
+  EXPECT_LT((sim.region_moves()->ball.center - far).norm(), 0.02);
+  const std::string json = sim.stats_json(0);
+  EXPECT_NE(json.find("\"region_moves\""), std::string::npos);
+  EXPECT_LT(test::relative_error_vs_full_model(sim), 1e-8);
+}
+
+double max_abs_diff(const Vector& a, const Vector& b) { return (a - b).cwiseAbs().maxCoeff(); }
+
+// Re-partitioning a cut thigh so that its cut falls in the condensed part changes no
+// displacement: same loads, same imposed (contact) displacements, same solution.
+TEST(FollowRegion, RepartitionedModelSolvesTheSameWithCutGeometryCondensed) {
+  Scene scene = make_thigh_scene();
+  scene.solver.tolerance = 1e-13;
+  Simulation sim(scene);
+  // One incision through the operation part (the scene's own stroke: press, draw, lift).
+  BladePose a, b;
+  a.position = Vec3(0.048, 0.003, 0.03);
+  b.position = Vec3(0.048, 0.003, 0.066);
+  const CutOutcome cut = sim.cut_along({a, b});
+  ASSERT_TRUE(cut.success) << cut.message;
+  const HybridModel& old_model = sim.model();
+  // Imposed displacements on three operation nodes far from the cut (a blade pressing there).
+  std::vector<int> pressed;
+  for (int n : old_model.partition().operation)
+    if ((old_model.mesh().nodes[n] - Vec3(0.06 * std::cos(0.6), 0.06 * std::sin(0.6), 0.048))
+            .norm() < 0.012)
+      pressed.push_back(n);
+  ASSERT_GE(pressed.size(), 3u);
+  pressed.resize(3);
+  // The new ball holds the pressed nodes but not the cut (centre ~35 degrees round the tube).
+  const Sphere ball{Vec3(0.06 * std::cos(0.9), 0.06 * std::sin(0.9), 0.048), 0.03};
+  HybridModel moved(old_model, follow_region_labels(old_model.mesh(), ball, pressed));
+  moved.set_cg_settings(old_model.cg_settings());
+  int cut_tets_condensed = 0;
+  for (int t : moved.partition().condensed_tets)
+    cut_tets_condensed += moved.mesh().cut_faces[t] != 0;
+  EXPECT_GT(cut_tets_condensed, 10) << "the cut must lie in the new condensed part";
+  for (int n : pressed) {
+    const NodeSet set = moved.partition().node_set[n];
+    ASSERT_TRUE(set == NodeSet::kOperation || set == NodeSet::kInterface);
+  }
+
+  ImposedDisplacements contact;
+  for (int n : pressed) contact[n] = Vec3(-0.002, 0.0005, 0.0);
+  HybridModel reference(old_model, old_model.partition().operation_tet);  // the old partition
+  reference.set_cg_settings(old_model.cg_settings());
+  ASSERT_TRUE(reference.solve(contact).converged);
+  moved.set_displacement(old_model.displacement());  // the swap hands the state over
+  ASSERT_TRUE(moved.solve(contact).converged);
+  reference.recover_interior();
+  moved.recover_interior();
+  const double scale = reference.displacement().cwiseAbs().maxCoeff();
+  EXPECT_LT(max_abs_diff(moved.displacement(), reference.displacement()), 1e-9 * scale);
+  // And the reaction on the pressed nodes (the blade's wrench) is the same.
+  EXPECT_LT((moved.reaction_force(pressed) - reference.reaction_force(pressed)).norm(),
+            1e-8 * reference.reaction_force(pressed).norm());
+}
+
+struct StrokeResult {
+  int steps = 0, moves = 0, steps_waiting = 0;
+  double opened = 0, swept = 0, error_vs_full = 0, max_gap = 0;
+  std::string hash;  // the final mesh
+  Vector u;          // the final displacement, every node
+};
+
+// Same final mesh: same displacement to 1e-9 of the largest (both models are exact).
+void expect_same_state(const StrokeResult& a, const StrokeResult& b, const char* what) {
+  std::printf("%s: final meshes %s\n", what, a.hash == b.hash ? "identical" : "differ");
+  EXPECT_EQ(a.hash, b.hash) << what;
+  if (a.hash != b.hash) return;
+  const double scale = b.u.cwiseAbs().maxCoeff();
+  const double diff = (a.u - b.u).cwiseAbs().maxCoeff();
+  std::printf("%s: max |u_follow - u_all| = %.2e of %.2e\n", what, diff, scale);
+  EXPECT_LT(diff, 1e-9 * scale) << what;
+}
+
+// Plays `poses` step by step; docs/SCENE.md "Cut invariants" and convergence after every step; at
+// the end the cut's opened area (one lip) against the area the edge swept inside the tissue, and
+// the largest gap along the stroke (`axis`) between opened cut faces near the blade plane.
+StrokeResult play_stroke(Simulation& sim, const std::vector<BladePose>& poses, const Vec3& axis,
+                         double from, double to) {
+  StrokeResult r;
+  const TetMesh rest = sim.mesh();
+  for (const BladePose& p : poses) {
+    const StepStats s = sim.step(p);
+    ++r.steps;
+    r.steps_waiting += s.region_moving;
+    if (std::getenv("FOLLOW_TRACE"))
+      std::printf(
+          "step %3d z %.4f cut %d split %3d iface %d moving %d moved %d centre %.4f %.4f %.4f\n",
+          static_cast<int>(s.step), p.position.z(), s.cutting, s.tets_split, s.reached_interface,
+          s.region_moving, s.region_moved,
+          sim.region_moves() ? sim.region_moves()->ball.center.x() : 0.0,
+          sim.region_moves() ? sim.region_moves()->ball.center.y() : 0.0,
+          sim.region_moves() ? sim.region_moves()->ball.center.z() : 0.0);
+    EXPECT_TRUE(s.converged) << "step " << s.step;
+    const auto violated = test::spec6_violations(sim);
+    EXPECT_TRUE(violated.empty()) << "step " << s.step << ": " << violated.front();
+    if (!violated.empty()) break;
+  }
+  sim.settle_region_move();
+  sim.step(std::nullopt);  // a last solve with the blade gone
+  r.moves = sim.region_moves() ? sim.region_moves()->moves : 0;
+  r.opened = 0.5 * open_cut_area(sim.mesh());
+  r.swept = test::swept_area_inside(rest, poses, sim.scene().scalpel.blade_length);
+  r.error_vs_full = test::relative_error_vs_full_model(sim);
+  r.hash = sim.mesh_hash();
+  r.u = sim.full_displacement();
+  // Gaps: positions along the axis of opened cut faces.
+  std::vector<double> along;
+  const TetMesh& m = sim.mesh();
+  for (const BoundaryTriangle& tri : extract_boundary_surface(m).triangles)
+    if (tri.cut) {
+      const Vec3 c = (m.nodes[tri.nodes[0]] + m.nodes[tri.nodes[1]] + m.nodes[tri.nodes[2]]) / 3;
+      along.push_back(c.dot(axis));
+    }
+  std::sort(along.begin(), along.end());
+  double last = from;
+  for (double x : along)
+    if (x >= from && x <= to) {
+      r.max_gap = std::max(r.max_gap, x - last);
+      last = x;
+    }
+  r.max_gap = std::max(r.max_gap, to - last);
+  if (std::getenv("FOLLOW_TRACE")) {
+    std::printf("closed cut faces %d; opened faces along:", closed_cut_faces(m));
+    for (double x : along) std::printf(" %.1f", x * 1e3);
+    std::printf("\n");
+  }
+  return r;
+}
+
+void report(const char* name, const Simulation& sim, const StrokeResult& r) {
+  const RegionMoveStats m = sim.region_moves() ? *sim.region_moves() : RegionMoveStats{};
+  std::printf(
+      "%s: %d tets, %d steps, %d region moves (%d failed; worker last %.1f ms, max "
+      "%.1f ms), %d steps with a move under way; opened %.2f cm^2 of %.2f cm^2 swept (%.1f %%); "
+      "largest gap "
+      "%.2f mm; vs full model %.2e\n",
+      name, sim.counts().tets, r.steps, r.moves, m.failed, m.last_ms, m.max_ms, r.steps_waiting,
+      r.opened * 1e4, r.swept * 1e4, 100 * r.opened / r.swept, r.max_gap * 1e3, r.error_vs_full);
+}
+
+// The thigh (whole tube refined, 14 cm long), a 2.5 cm ball: a 10 cm incision along it,
+// against the same stroke with `operation_region: all` (nothing condensed, nothing moves):
+// the moves must cost no cut area and leave no gap that the cutter alone does not leave.
+TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
+  test::TempDir dir;
+  const std::string path = test::write_file(
+      dir.file("s.yaml"),
+      "mesh: {generator: {type: thigh, length: 0.14, resolution: 0.7}}\n"
+      "fixed: [{box: {min: [-0.0151, -0.0151, -0.001], max: [0.0151, 0.0151, 0.141]}}]\n"
+      "operation_region: {follow: {radius: 0.025}}\n"
+      "gravity: [0, -9.81, 0]\n"
+      "scalpel: {blade_length: 0.02, cut_pressure: 0.3}\n"
+      "trajectory: [{t: 0, position: [0.065, 0.003, 0.02]}]\n"
+      "solver: {tolerance: 1.0e-12}\n");
+  const Scene scene = load_scene(path);
+  const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // edge radially out (+x)
+  std::vector<BladePose> poses;
+  const double x_in = 0.06 - 0.012;
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(0.065, 0.003, 0.02), 1, q);
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(x_in, 0.003, 0.02), 17, q);  // press
+  test::append_line(poses, Vec3(x_in, 0.003, 0.02), Vec3(x_in, 0.003, 0.12), 200, q);  // draw
+  test::append_line(poses, Vec3(x_in, 0.003, 0.12), Vec3(0.07, 0.003, 0.12), 20, q);   // lift
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation follow(scene, offline);
+  const StrokeResult r = play_stroke(follow, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, follow", follow, r);
+  Scene all = scene;
+  all.operation_region.kind = OperationRegion::Kind::kAll;
+  Simulation reference(all);
+  const StrokeResult b = play_stroke(reference, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, all (no moves)", reference, b);
+  EXPECT_GE(r.moves, 3);
+  EXPECT_GE(r.opened, 0.9 * b.opened);
+  EXPECT_LE(r.max_gap, b.max_gap + 0.003);  // no gap at the moves beyond the cutter's own
+  EXPECT_LT(r.error_vs_full, 1e-9);
+  EXPECT_LT(b.error_vs_full, 1e-9);
+  expect_same_state(r, b, "thigh, follow (offline) vs all");
+  // Online: the loop never waits; the cut waits at the interface while a move runs and
+  // catches up at the swap. Not deterministic in when it moves, so no mesh comparison.
+  Simulation online(scene);
+  const StrokeResult o = play_stroke(online, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, follow online", online, o);
+  EXPECT_GE(o.moves, 3);
+  EXPECT_GE(o.opened, 0.9 * b.opened);
+  EXPECT_LT(o.error_vs_full, 1e-9);
+}
+
+// A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 2 cm
+// ball: a 10 cm stroke along x across its top, 6 mm below the surface, edge up, against
+// `operation_region: all`.
+TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
+  test::TempDir dir;
+  const std::string path = test::write_file(
+      dir.file("s.yaml"),
+      "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
+          "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
+          "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
+          "operation_region: {follow: {radius: 0.02}}\n"
+          "gravity: [0, -9.81, 0]\n"
+          "scalpel: {blade_length: 0.02, cut_pressure: 0.01}\n"
+          "trajectory: [{t: 0, position: [-0.065, 0.01, 0.768]}]\n"
+          "solver: {tolerance: 1.0e-12}\n");
+  const Scene scene = load_scene(path);
+  // The top surface along the stroke line (z = 0.768): the highest rest point inside.
+  TetGrid grid;
+  grid.build(scene.mesh, {});
+  auto top = [&](double x) {
+    for (double y = 0.01; y > -0.05; y -= 0.0002)
+      if (tet_containing(scene.mesh, grid, Vec3(x, y, 0.768)) >= 0) return y;
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  // Edge along world +y (up), blade normal along world z: the blade plane holds the x motion.
+  Eigen::Matrix3d r;
+  r.col(0) = Vec3::UnitY();
+  r.col(1) = Vec3::UnitZ();
+  r.col(2) = Vec3::UnitX();
+  const Eigen::Quaterniond q(r);
+  const double depth = 0.006, x0 = -0.065, x1 = 0.035;
+  ASSERT_FALSE(std::isnan(top(x0)));
+  std::vector<BladePose> poses;
+  const Vec3 above(x0, top(x0) + 0.005, 0.768), in(x0, top(x0) - depth, 0.768);
+  test::append_line(poses, above, above, 1, q);
+  test::append_line(poses, above, in, 20, q);  // press down, edge first: presses, then yields
+  Vec3 last = in;
+  for (int k = 1; k <= 200; ++k) {  // 0.5 mm per step, following the surface
+    const double x = x0 + (x1 - x0) * k / 200;
+    const double y = top(x);
+    if (std::isnan(y)) break;  // off the liver
+    const Vec3 next(x, y - depth, 0.768);
+    test::append_line(poses, last, next, 1, q);
+    last = next;
+  }
+  const double stroke = last.x() - x0;
+  test::append_line(poses, last, last + Vec3(0, 0.03, 0), 20, q);  // lift out along the edge
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation follow(scene, offline);
+  const StrokeResult f = play_stroke(follow, poses, Vec3::UnitX(), x0 + 0.01, last.x() - 0.01);
+  std::printf("liver stroke %.1f cm\n", stroke * 100);
+  report("liver stroke, follow", follow, f);
+  Scene all = scene;
+  all.operation_region.kind = OperationRegion::Kind::kAll;
+  Simulation reference(all);
+  const StrokeResult b = play_stroke(reference, poses, Vec3::UnitX(), x0 + 0.01, last.x() - 0.01);
+  report("liver stroke, all (no moves)", reference, b);
+  EXPECT_GT(stroke, 0.08);
+  EXPECT_GE(f.moves, 3);
+  EXPECT_GE(f.opened, 0.9 * b.opened);
+  EXPECT_LE(f.max_gap, b.max_gap + 0.003);
+  EXPECT_LT(f.error_vs_full, 1e-9);
+  EXPECT_LT(b.error_vs_full, 1e-9);
+  // The liver's cut differs from `all` in a few tets (6807 vs 6818 at the time of writing):
+  // a sweep cut across a move is not always split the same way. Reported, not asserted.
+  std::printf("liver: final meshes %s\n", f.hash == b.hash ? "identical" : "differ");
+}
+
+}  // namespace
+}  // namespace stc
