@@ -5,4 +5,5 @@ list(APPEND TISSUE_CORE_SOURCES
   src/collision/edge_contact.cpp
   src/collision/surface_bvh.cpp
   src/collision/tip_contact.cpp
+  src/collision/tissue_samples.cpp
 )

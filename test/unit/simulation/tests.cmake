@@ -4,6 +4,7 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/simulation/test_hybrid_model_livers.cpp
   test/unit/simulation/test_hybrid_model_recovery.cpp
   test/unit/simulation/test_operation_surface.cpp
+  test/unit/simulation/test_region_follower.cpp
   test/unit/simulation/test_simulation.cpp
   test/unit/simulation/test_simulation_edge_contact.cpp
   test/unit/simulation/test_simulation_random_cuts.cpp

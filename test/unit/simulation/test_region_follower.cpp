@@ -3,7 +3,7 @@
 // displacement, cut tets condensed with the rest), and a 10 cm stroke across the thigh and a
 // TetGen liver, crossing several region moves, cuts continuously, keeps docs/SCENE.md "Cut
 // invariants" after every step and equals the full model at the end.
-#include "follow_stroke_util.hpp"
+#include "common/follow_stroke.hpp"
 
 #include "soft_tissue_cutting/collision/tissue_samples.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
@@ -11,7 +11,7 @@
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/region_follower.hpp"
 
-#include "test_io_util.hpp"
+#include "common/mesh_files.hpp"
 
 #include <gtest/gtest.h>
 
