@@ -4,11 +4,11 @@
 // of config/scenes/liver_organ.yaml (its 2 cm sphere made a `follow` ball); the same model built
 // from scratch (element matrices recomputed) for the gain of re-using them; and the per-step solve
 // while a move runs on the other core.
+#include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/collision/tissue_samples.hpp"
+#include "collision/tissue_samples.hpp"
 
 #include <algorithm>
 #include <cmath>

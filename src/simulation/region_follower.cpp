@@ -1,6 +1,6 @@
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
+#include "simulation/region_follower.hpp"
 
-#include "soft_tissue_cutting/collision/tissue_samples.hpp"
+#include "collision/tissue_samples.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 
 #include <algorithm>

@@ -3,6 +3,7 @@
 #include "cutting/cut_state.hpp"
 #include "cutting/cut_sweep.hpp"
 #include "cutting/free_pieces.hpp"
+#include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
@@ -10,7 +11,6 @@
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 // The offline outputs of docs/SCENE.md "Offline run": the VTK state and the JSON statistics.
+#include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 

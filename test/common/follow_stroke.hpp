@@ -2,11 +2,11 @@
 // area its edge sweeps inside the (rest) tissue, and the opened cut area.
 #pragma once
 
+#include "collision/tissue_samples.hpp"
+#include "common/cut_measures.hpp"
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
-#include "soft_tissue_cutting/collision/tissue_samples.hpp"
-#include "soft_tissue_cutting/cutting/cut_measures.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"

@@ -19,7 +19,7 @@
 #include "soft_tissue_cutting/ros/loop_monitor.hpp"
 #include "soft_tissue_cutting/ros/node_params.hpp"
 #include "soft_tissue_cutting/ros/pose_input.hpp"
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
+#include "soft_tissue_cutting/simulation/region_move_stats.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include <diagnostic_updater/diagnostic_updater.h>

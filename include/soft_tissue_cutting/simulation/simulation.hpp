@@ -17,7 +17,7 @@
 namespace stc {
 
 class HybridModel;
-struct RegionMoveStats;  // simulation/region_follower.hpp
+struct RegionMoveStats;  // simulation/region_move_stats.hpp
 struct StepTimes;        // simulation/step_times.hpp
 
 struct SimulationOptions {

@@ -5,11 +5,11 @@
 // invariants" after every step and equals the full model at the end.
 #include "common/follow_stroke.hpp"
 
-#include "soft_tissue_cutting/collision/tissue_samples.hpp"
+#include "collision/tissue_samples.hpp"
+#include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
-#include "soft_tissue_cutting/simulation/region_follower.hpp"
 
 #include "common/mesh_files.hpp"
 
@@ -184,7 +184,7 @@ StrokeResult play_stroke(Simulation& sim, const std::vector<BladePose>& poses, c
   sim.settle_region_move();
   sim.step(std::nullopt);  // a last solve with the blade gone
   r.moves = sim.region_moves() ? sim.region_moves()->moves : 0;
-  r.opened = 0.5 * open_cut_area(sim.mesh());
+  r.opened = 0.5 * test::open_cut_area(sim.mesh());
   r.swept = test::swept_area_inside(rest, poses, sim.scene().scalpel.blade_length);
   r.error_vs_full = test::relative_error_vs_full_model(sim);
   r.hash = sim.mesh_hash();
@@ -206,7 +206,7 @@ StrokeResult play_stroke(Simulation& sim, const std::vector<BladePose>& poses, c
     }
   r.max_gap = std::max(r.max_gap, to - last);
   if (std::getenv("FOLLOW_TRACE")) {
-    std::printf("closed cut faces %d; opened faces along:", closed_cut_faces(m));
+    std::printf("closed cut faces %d; opened faces along:", test::closed_cut_faces(m));
     for (double x : along) std::printf(" %.1f", x * 1e3);
     std::printf("\n");
   }

@@ -4,8 +4,8 @@
 // operation region live there.
 #pragma once
 
+#include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
-#include "soft_tissue_cutting/cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
 
 #include <vector>

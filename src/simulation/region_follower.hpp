@@ -12,11 +12,12 @@
 // condensed with the rest; tets around held nodes stay in part 1.
 #pragma once
 
+#include "cutting/cut_state.hpp"
+#include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
-#include "soft_tissue_cutting/cutting/cut_state.hpp"
-#include "soft_tissue_cutting/cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
+#include "soft_tissue_cutting/simulation/region_move_stats.hpp"
 
 #include <chrono>
 #include <future>
@@ -26,18 +27,6 @@
 #include <vector>
 
 namespace stc {
-
-struct RegionMoveStats {
-  int moves = 0;        // new models swapped in since the start (or the last reset)
-  int failed = 0;       // re-condensations that failed or were dropped (the old model stayed)
-  bool moving = false;  // a re-condensation is running on the worker thread now
-  double last_ms = 0;   // worker time of the last completed move (partition + condensation)
-  double max_ms = 0, total_ms = 0;
-  std::vector<double> durations_ms;  // every completed move's worker time, in order
-  double last_wait_ms = 0;           // from the last request to its swap (the cut waited)
-  Sphere ball;                       // where the region is now
-  std::string last_reason;           // why the last move was requested
-};
 
 // What a move builds on the worker: the new model and everything the step needs of its
 // partition, so the swap itself only exchanges pointers.
