@@ -6,6 +6,7 @@
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
@@ -13,8 +14,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <sstream>
 #include <string>
 
 namespace stc {
@@ -41,6 +44,72 @@ SparseMatrix free_block(const Simulation& sim) {
   SparseMatrix out(rows, rows);
   out.setFromTriplets(t.begin(), t.end());
   return out;
+}
+
+// The held DOFs of the hybrid system (the nodes of free pieces, as free_block excludes them).
+std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
+  const HybridModel& model = sim.model();
+  std::vector<std::uint8_t> anchored = model.fixed_nodes();
+  for (int i : model.partition().interface) anchored[static_cast<size_t>(i)] = 1;
+  std::vector<std::uint8_t> held(anchored.size(), 0);
+  for (const MeshPiece& piece : free_pieces(model.mesh(), anchored))
+    for (int n : piece.nodes) held[static_cast<size_t>(n)] = 1;
+  const DofMap& dofs = model.hybrid_dofs();
+  std::vector<std::uint8_t> out(static_cast<size_t>(dofs.rows()), 0);
+  for (int r = 0; r < dofs.rows(); ++r)
+    out[static_cast<size_t>(r)] =
+        held[static_cast<size_t>(dofs.global_of[static_cast<size_t>(r)] / 3)];
+  return out;
+}
+
+// Why a solve did not converge: the preconditioner that was active, the solver's message, the
+// element quality, and the same system re-solved from the held values with each
+// preconditioner at growing iteration caps (the residual history), plus a direct solve of the
+// free block (the residual double precision can reach at all).
+std::string solve_diagnosis(const Simulation& sim) {
+  const HybridModel& model = sim.model();
+  const CgResult& last = model.last_result();
+  const MeshQuality q = mesh_quality(sim.mesh());
+  std::ostringstream o;
+  o << "preconditioner " << model.solver().preconditioner() << ", " << last.iterations
+    << " iterations, residual " << last.residual << " (" << last.message << "); "
+    << sim.counts().tets << " tets, " << sim.counts().free_pieces_held << " free pieces held, "
+    << model.hybrid_dofs().rows() << " DOFs; min dihedral " << q.min_dihedral_deg
+    << " deg, max dihedral " << q.max_dihedral_deg << " deg, min volume ratio "
+    << q.min_volume_ratio << ", min volume " << q.min_volume << " m^3";
+  const SparseMatrix& a = model.hybrid_matrix();
+  const Vector& b = model.hybrid_rhs();
+  const std::vector<std::uint8_t> held = held_dofs(sim);
+  Vector start = Vector::Zero(a.rows());
+  const Vector u = model.operation_displacement();
+  for (int r = 0; r < a.rows(); ++r)
+    if (held[static_cast<size_t>(r)])
+      start[r] = u[model.hybrid_dofs().global_of[static_cast<size_t>(r)]];
+  for (CgPreconditioner pc : {CgPreconditioner::kCholesky, CgPreconditioner::kJacobi}) {
+    auto solver = make_cpu_solver(pc);
+    solver->set_matrix(a);
+    o << "\n  " << solver->preconditioner() << " from the held values:";
+    for (int cap : {1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 10000}) {
+      Vector x = start;
+      CgSettings settings = model.cg_settings();
+      settings.max_iterations = cap;
+      const CgResult r = solver->solve(b, x, held, settings);
+      o << " " << r.iterations << ":" << r.residual;
+      if (r.converged || r.iterations < cap) break;
+    }
+  }
+  try {
+    Vector x = start;
+    solve_direct(a, b, x, held);
+    Vector r = (b - a * x);
+    Vector rf = r, rhs = b - a * start.cwiseProduct(Vector::Ones(a.rows()));
+    for (int i = 0; i < a.rows(); ++i)
+      if (held[static_cast<size_t>(i)]) rf[i] = rhs[i] = 0;
+    o << "\n  direct solve of the free block: relative residual " << rf.norm() / rhs.norm();
+  } catch (const std::exception& e) {
+    o << "\n  direct solve of the free block failed: " << e.what();
+  }
+  return o.str();
 }
 
 // One random stroke: a straight sweep of `length` * U(-1, 1)^3 starting within `spread` of
@@ -79,7 +148,9 @@ int run_random_strokes(Simulation& sim, RandomStrokes& random, int strokes, cons
     if (k % spd_every == 0 || k + 1 == strokes) {
       EXPECT_NO_THROW(SparseCholesky{free_block(sim)}) << "sweep " << k << ": not SPD";
     }
-    EXPECT_TRUE(sim.model().last_result().converged) << "sweep " << k;
+    EXPECT_TRUE(sim.model().last_result().converged)
+        << "sweep " << k << ": "
+        << (sim.model().last_result().converged ? std::string() : solve_diagnosis(sim));
     EXPECT_TRUE(sim.model().displacement().allFinite()) << "sweep " << k;
     if (::testing::Test::HasFailure()) return cuts;
   }
