@@ -213,12 +213,20 @@ class Soak:
 
     def run(self):
         a = self.args
-        for _ in range(200):
-            if self.steps > 0 and self.region is not None:
-                break
+        # Start-up: an organ-scale scene condenses for tens of seconds (longer on a loaded
+        # machine) before the first step; the load starts only once the node steps.
+        started = time.monotonic()
+        while not (self.steps > 0 and self.region is not None):
+            if time.monotonic() - started > a.startup_s or not os.path.exists("/proc/%d" % a.pid):
+                print("soak: FAIL: the node did not start stepping within %.0f s" % a.startup_s,
+                      flush=True)
+                return 1
             time.sleep(0.1)
+        print("soak: node stepping after %.1f s; load starts" % (time.monotonic() - started),
+              flush=True)
         stop = threading.Event()
-        walker = threading.Thread(target=self.walk, args=(stop,))
+        # daemon: an exception in the driver must not leave the process (and the node) running
+        walker = threading.Thread(target=self.walk, args=(stop,), daemon=True)
         walker.start()
         time.sleep(5.0)  # warm-up: RSS start after the first cuts' allocations settle a little
         rss_start = rss_mb(a.pid)
@@ -310,6 +318,8 @@ def main():
     p.add_argument("--out", default="/tmp")
     p.add_argument("--max-rss-growth-mb", type=float, default=64.0,
                    help="fail if the node's RSS grows by more (end - start after warm-up)")
+    p.add_argument("--startup-s", type=float, default=600.0,
+                   help="fail if the node has not stepped (and drawn its region) by then")
     p.add_argument("--max-gap-s", type=float, default=2.0,
                    help="fail if ~stats goes quiet for longer (a stalled loop)")
     a = p.parse_args(rospy.myargv()[1:])
