@@ -159,7 +159,14 @@ int run_random_strokes(Simulation& sim, RandomStrokes& random, int strokes, cons
 
 TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
   const Scene scene = make_thigh_scene();
-  Simulation sim(scene);
+  // Every piece held is said once through the log sink (the core never prints itself).
+  int held_messages = 0;
+  SimulationOptions options;
+  options.log = [&held_messages](LogLevel level, const std::string& message) {
+    EXPECT_EQ(level, LogLevel::kInfo);
+    if (message.find("was cut free; it is held in place") != std::string::npos) ++held_messages;
+  };
+  Simulation sim(scene, options);
   RandomStrokes random(20261122);
   constexpr int kSweeps = 300;
   const int cuts = run_random_strokes(sim, random, kSweeps, scene.operation_region.sphere.center,
@@ -167,6 +174,7 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
   std::printf("random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n", cuts,
               kSweeps, sim.counts().tets_split, sim.counts().tets, sim.counts().free_pieces_held);
   EXPECT_GT(cuts, kSweeps / 3);
+  EXPECT_EQ(held_messages, sim.counts().free_pieces_held);
 }
 
 // The same property on a TetGen liver (config/scenes/liver2_surface.yaml, tetrahedralized from

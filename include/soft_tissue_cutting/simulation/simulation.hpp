@@ -3,11 +3,14 @@
 // and the offline `./tissue solve` both drive this class.
 #pragma once
 
+#include "soft_tissue_cutting/gpu/gl_context_options.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
+#include "soft_tissue_cutting/simulation/model_counts.hpp"  // ModelCounts
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -19,8 +22,16 @@ namespace stc {
 class HybridModel;
 struct StepTimes;  // simulation/step_times.hpp
 
+// The core's log sink: where Simulation sends its messages (a free piece held, ...). The core
+// never writes to stderr itself: `tissue solve` prints them, tissue_node routes them to
+// rosconsole (so they reach /rosout). Empty: dropped.
+enum class LogLevel { kInfo, kWarn, kError };
+using LogSink = std::function<void(LogLevel level, const std::string& message)>;
+
 struct SimulationOptions {
-  std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
+  std::optional<Backend> backend;  // nullopt: the scene's solver.backend
+  GlContextOptions gl;             // the gl backend's context and shader folder
+  LogSink log;
 };
 
 // Stage timings and outcome of one step.
@@ -44,18 +55,9 @@ struct StepStats {
   int tets_split = 0;              // this step
   int nodes_added = 0;             // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
-  double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
+  // No recovery_ms: a step never recovers the condensed surface (surface() does, on demand).
+  double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0;
   double step_ms = 0;
-};
-
-// Sizes of the current state (after cuts), as docs/SCENE.md "Offline run" names them.
-struct ModelCounts {
-  int nodes = 0, tets = 0, dof_operation = 0, nodes_interface = 0;
-  int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
-  int cuts = 0, tets_split = 0, free_pieces_held = 0;
-  long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
-  long solver_fallbacks = 0;     // gl solves finished on the cpu since the start (or reset)
-  double volume_initial = 0, volume_final = 0;
 };
 
 struct CutOutcome {
