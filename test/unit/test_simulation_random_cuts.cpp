@@ -23,29 +23,6 @@
 namespace stc {
 namespace {
 
-// The hybrid matrix restricted to the DOFs that are not held.
-SparseMatrix free_block(const Simulation& sim) {
-  const HybridModel& model = sim.model();
-  std::vector<std::uint8_t> anchored = model.fixed_nodes();
-  for (int i : model.partition().interface) anchored[static_cast<size_t>(i)] = 1;
-  std::vector<std::uint8_t> held(anchored.size(), 0);
-  for (const MeshPiece& piece : free_pieces(model.mesh(), anchored))
-    for (int n : piece.nodes) held[static_cast<size_t>(n)] = 1;
-  const DofMap& dofs = model.hybrid_dofs();
-  std::vector<int> keep(static_cast<size_t>(dofs.rows()), -1);
-  int rows = 0;
-  for (int r = 0; r < dofs.rows(); ++r)
-    if (!held[static_cast<size_t>(dofs.global_of[static_cast<size_t>(r)] / 3)]) keep[r] = rows++;
-  std::vector<Eigen::Triplet<double>> t;
-  const SparseMatrix& a = model.hybrid_matrix();
-  for (int r = 0; r < a.outerSize(); ++r)
-    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
-      if (keep[r] >= 0 && keep[it.col()] >= 0) t.emplace_back(keep[r], keep[it.col()], it.value());
-  SparseMatrix out(rows, rows);
-  out.setFromTriplets(t.begin(), t.end());
-  return out;
-}
-
 // The held DOFs of the hybrid system (the nodes of free pieces, as free_block excludes them).
 std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
   const HybridModel& model = sim.model();
@@ -59,6 +36,23 @@ std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
   for (int r = 0; r < dofs.rows(); ++r)
     out[static_cast<size_t>(r)] =
         held[static_cast<size_t>(dofs.global_of[static_cast<size_t>(r)] / 3)];
+  return out;
+}
+
+// The hybrid matrix restricted to the DOFs that are not held.
+SparseMatrix free_block(const Simulation& sim) {
+  const std::vector<std::uint8_t> held = held_dofs(sim);
+  std::vector<int> keep(held.size(), -1);
+  int rows = 0;
+  for (size_t r = 0; r < held.size(); ++r)
+    if (!held[r]) keep[r] = rows++;
+  std::vector<Eigen::Triplet<double>> t;
+  const SparseMatrix& a = sim.model().hybrid_matrix();
+  for (int r = 0; r < a.outerSize(); ++r)
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
+      if (keep[r] >= 0 && keep[it.col()] >= 0) t.emplace_back(keep[r], keep[it.col()], it.value());
+  SparseMatrix out(rows, rows);
+  out.setFromTriplets(t.begin(), t.end());
   return out;
 }
 
