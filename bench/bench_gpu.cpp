@@ -39,9 +39,9 @@ struct Gl {
 Gl& gl() {
   static Gl g = [] {
     Gl out;
-    out.ctx = EglContext::create(&out.why_not);
+    out.ctx = EglContext::create(GlContextOptions{}, &out.why_not);
     if (out.ctx) {
-      out.shaders = std::make_unique<ShaderLibrary>(out.ctx->api());
+      out.shaders = std::make_unique<ShaderLibrary>(out.ctx->api(), "");
       out.runner = std::make_unique<PassRunner>(*out.shaders);
     }
     return out;

@@ -31,4 +31,5 @@ rosrun soft_tissue_cutting tissue_node __name:=tissue _scene:="$scene" >"$out/no
 node=$!
 pids=("$node" "${pids[@]}")
 echo "soak: scene $scene for $minutes min, node pid $node, logs in $out"
-python3 "$here/soak_driver.py" --minutes "$minutes" --pid "$node" --out "$out"
+python3 "$here/soak_driver.py" --minutes "$minutes" --pid "$node" --out "$out" \
+  --startup-s "${TISSUE_SOAK_STARTUP_S:-600}"

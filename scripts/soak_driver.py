@@ -6,8 +6,13 @@ Load: a random-walk scalpel on scalpel/pose at 100 Hz around the operation regio
 cuts and leaves the tissue again), every ~5 s a burst of service calls from 4 threads
 (~set_cutting, short ~cut paths, ~save), every ~60 s a ~reset. Measured: steps, cuts, worst
 step (~stats step_ms), ~stats rate per 1 s window (percentiles), node RSS start/end, every
-non-finite number in ~stats, ~scalpel/wrench and ~surface, node deaths. Exit 1 if the node
-died or published a non-finite number."""
+non-finite number in ~stats, ~scalpel/wrench and ~surface, the longest time without a ~stats
+message, /diagnostics levels, node deaths.
+
+Pass/fail (the last line says PASS or FAIL and why; exit 1 on FAIL): the node stays alive, no
+non-finite number is published, no service call fails (crash or hang), RSS grows by at most
+--max-rss-growth-mb from the start (after a 5 s warm-up) to the end, and no stall: ~stats never
+goes quiet for longer than --max-gap-s."""
 import argparse
 import math
 import os
@@ -21,6 +26,7 @@ import rospy
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from soft_tissue_cutting.msg import SimStats
 from soft_tissue_cutting.srv import Cut, CutRequest, SaveMesh
+from diagnostic_msgs.msg import DiagnosticArray
 from std_srvs.srv import SetBool, Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -46,6 +52,7 @@ def percentile(values, p):
 class Soak:
     def __init__(self, args):
         self.args = args
+        self.measuring = False  # gaps count from the end of the warm-up
         self.lock = threading.Lock()
         self.steps = 0
         self.first_step = None
@@ -60,18 +67,27 @@ class Soak:
         self.calls = {"ok": 0, "refused": 0, "failed": 0}
         self.resets = 0
         self.service_cuts = 0
+        self.last_stats_time = None  # monotonic time of the last ~stats message
+        self.longest_gap_s = 0.0
+        self.diagnostics = {0: 0, 1: 0, 2: 0, 3: 0}  # tissue: simulation, by level
+        self.diagnostics_errors = {}  # summary -> count (ERROR only)
         rospy.Subscriber("/tissue/stats", SimStats, self.on_stats, queue_size=1000)
         rospy.Subscriber("/tissue/scalpel/wrench", WrenchStamped, self.on_wrench, queue_size=1000)
         rospy.Subscriber("/tissue/surface", Marker, self.on_surface, queue_size=5)
         rospy.Subscriber("/tissue/markers", MarkerArray, self.on_markers, queue_size=5)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics, queue_size=10)
         self.pose_pub = rospy.Publisher("/scalpel/pose", PoseStamped, queue_size=100)
 
     def on_stats(self, m):
         values = [m.residual, m.contact_force, m.collision_ms, m.cutting_ms, m.assembly_ms,
                   m.solve_ms, m.recovery_ms, m.step_ms, m.rate_hz]
+        now = time.monotonic()
         with self.lock:
             if not all(math.isfinite(v) for v in values):
                 self.nonfinite["stats"] += 1
+            if self.last_stats_time is not None and self.measuring:
+                self.longest_gap_s = max(self.longest_gap_s, now - self.last_stats_time)
+            self.last_stats_time = now
             self.steps += 1
             if self.first_step is None:
                 self.first_step = m.step
@@ -83,6 +99,17 @@ class Soak:
             self.worst_step_ms = max(self.worst_step_ms, m.step_ms)
             sec = int(time.monotonic())
             self.stats_per_second[sec] = self.stats_per_second.get(sec, 0) + 1
+
+    def on_diagnostics(self, a):
+        for st in a.status:
+            if not st.name.endswith("simulation"):
+                continue
+            level = ord(st.level) if isinstance(st.level, bytes) else int(st.level)
+            with self.lock:
+                self.diagnostics[level] = self.diagnostics.get(level, 0) + 1
+                if level == 2:
+                    key = st.message.split(":")[0]
+                    self.diagnostics_errors[key] = self.diagnostics_errors.get(key, 0) + 1
 
     def on_wrench(self, w):
         f, t = w.wrench.force, w.wrench.torque
@@ -186,15 +213,25 @@ class Soak:
 
     def run(self):
         a = self.args
-        for _ in range(200):
-            if self.steps > 0 and self.region is not None:
-                break
+        # Start-up: an organ-scale scene condenses for tens of seconds (longer on a loaded
+        # machine) before the first step; the load starts only once the node steps.
+        started = time.monotonic()
+        while not (self.steps > 0 and self.region is not None):
+            if time.monotonic() - started > a.startup_s or not os.path.exists("/proc/%d" % a.pid):
+                print("soak: FAIL: the node did not start stepping within %.0f s" % a.startup_s,
+                      flush=True)
+                return 1
             time.sleep(0.1)
+        print("soak: node stepping after %.1f s; load starts" % (time.monotonic() - started),
+              flush=True)
         stop = threading.Event()
-        walker = threading.Thread(target=self.walk, args=(stop,))
+        # daemon: an exception in the driver must not leave the process (and the node) running
+        walker = threading.Thread(target=self.walk, args=(stop,), daemon=True)
         walker.start()
         time.sleep(5.0)  # warm-up: RSS start after the first cuts' allocations settle a little
         rss_start = rss_mb(a.pid)
+        with self.lock:
+            self.measuring = True
         rng = random.Random(7)
         reset = rospy.ServiceProxy("/tissue/reset", Trigger)
         tmp = tempfile.mkdtemp(prefix="soak_")
@@ -226,6 +263,8 @@ class Soak:
         stop.set()
         walker.join()
         with self.lock:
+            if self.last_stats_time is not None:  # a gap still open at the end counts too
+                self.longest_gap_s = max(self.longest_gap_s, time.monotonic() - self.last_stats_time)
             secs = sorted(self.stats_per_second)[1:-1]  # whole seconds only
             rates = [self.stats_per_second[s] for s in secs]
             report = [
@@ -244,9 +283,28 @@ class Soak:
                 "  non-finite:       %d stats, %d wrench, %d surface (of %d surfaces)" % (
                     self.nonfinite["stats"], self.nonfinite["wrench"], self.nonfinite["surface"],
                     self.surfaces),
+                "  longest ~stats gap: %.2f s" % self.longest_gap_s,
+                "  /diagnostics:     %d OK, %d WARN, %d ERROR%s" % (
+                    self.diagnostics[0], self.diagnostics[1], self.diagnostics[2],
+                    "" if not self.diagnostics_errors else " (" + ", ".join(
+                        "%s: %d" % kv for kv in sorted(self.diagnostics_errors.items())) + ")"),
                 "  node:             %s" % ("DIED" if died else "alive"),
             ]
-            bad = died or sum(self.nonfinite.values()) > 0 or self.calls["failed"] > 0
+            growth = rss_end - rss_start
+            failures = []
+            if died:
+                failures.append("the node died")
+            if sum(self.nonfinite.values()) > 0:
+                failures.append("%d non-finite outputs" % sum(self.nonfinite.values()))
+            if self.calls["failed"] > 0:
+                failures.append("%d service calls failed" % self.calls["failed"])
+            if not math.isfinite(growth) or growth > a.max_rss_growth_mb:
+                failures.append("RSS grew by %.0f MB (limit %.0f MB)" % (growth, a.max_rss_growth_mb))
+            if self.steps == 0 or self.longest_gap_s > a.max_gap_s:
+                failures.append("stall: no ~stats for %.2f s (limit %.2f s)" % (
+                    self.longest_gap_s, a.max_gap_s))
+            report.append("soak: PASS" if not failures else "soak: FAIL: " + "; ".join(failures))
+            bad = bool(failures)
         print("\n".join(report), flush=True)
         with open(os.path.join(a.out, "report.txt"), "w") as f:
             f.write("\n".join(report) + "\n")
@@ -258,6 +316,12 @@ def main():
     p.add_argument("--minutes", type=float, default=10.0)
     p.add_argument("--pid", type=int, required=True)
     p.add_argument("--out", default="/tmp")
+    p.add_argument("--max-rss-growth-mb", type=float, default=64.0,
+                   help="fail if the node's RSS grows by more (end - start after warm-up)")
+    p.add_argument("--startup-s", type=float, default=600.0,
+                   help="fail if the node has not stepped (and drawn its region) by then")
+    p.add_argument("--max-gap-s", type=float, default=2.0,
+                   help="fail if ~stats goes quiet for longer (a stalled loop)")
     a = p.parse_args(rospy.myargv()[1:])
     rospy.init_node("tissue_soak", anonymous=True, disable_signals=True)
     sys.exit(Soak(a).run())

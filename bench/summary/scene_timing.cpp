@@ -2,6 +2,7 @@
 
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/model_counts_json.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
@@ -71,13 +72,8 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   j["precompute_ms"] = ms_since(t0);  // condensation + hybrid factor + initial equilibrium
   nlohmann::json cpu;
   cpu["precompute"] = cpu_ms_now() - c0;
-  const ModelCounts counts = sim.counts();
   j["name"] = c.name;
-  j["tets"] = counts.tets;
-  j["nodes"] = counts.nodes;
-  j["dof_operation"] = counts.dof_operation;
-  j["nodes_interface"] = counts.nodes_interface;
-  j["nodes_surface_condensed"] = counts.nodes_surface_condensed;
+  add_model_sizes(j, sim.counts());
 
   // Idle: no blade, nothing changed since the last step.
   std::vector<double> idle, idle_cpu;

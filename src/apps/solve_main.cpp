@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <string>
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
       if (!value(stats)) return usage("--stats needs a path");
     } else if (arg == "--backend") {
       if (!value(backend)) return usage("--backend needs cpu or gl");
-      if (backend != "cpu" && backend != "gl") return usage("--backend must be cpu or gl");
+      if (!stc::parse_backend(backend)) return usage("--backend must be cpu or gl");
     } else if (!arg.empty() && arg[0] == '-') {
       return usage(("unknown option " + arg).c_str());
     } else if (scene_path.empty()) {
@@ -53,7 +54,13 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   try {
     stc::SimulationOptions options;
-    options.backend = backend;
+    if (!backend.empty()) options.backend = stc::parse_backend(backend);
+    options.gl = stc::gl_context_options_from(std::getenv("TISSUE_FORCE_NO_EGL"),
+                                              std::getenv("TISSUE_GL_API"),
+                                              std::getenv("TISSUE_SHADER_DIR"));
+    options.log = [](stc::LogLevel, const std::string& message) {
+      std::fprintf(stderr, "tissue solve: %s\n", message.c_str());
+    };
     // A `follow` region's moves are awaited offline (no real time to keep): deterministic.
     options.wait_for_region_moves = true;
     stc::Simulation sim(stc::load_scene(scene_path), options);

@@ -138,7 +138,7 @@ Scene make_thigh_scene(double resolution) {
   scene.trajectory = {pose(0.0, x0 + 0.005, z0), pose(0.2, x0 - 0.004, z0),
                       pose(0.4, x0 - 0.012, z0), pose(0.6, x0 - 0.012, 0.5 * (z0 + z1)),
                       pose(0.8, x0 - 0.012, z1), pose(1.0, x0 + 0.005, z1)};
-  scene.solver = SolverParams{"cpu", 1e-10, 2000};
+  scene.solver = SolverParams{Backend::kCpu, 1e-10, 2000};
   return scene;
 }
 

@@ -118,14 +118,13 @@ void device_candidates(const char* client_ext, std::vector<Candidate>& out, std:
 
 }  // namespace
 
-std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
+std::unique_ptr<EglContext> EglContext::create(const GlContextOptions& options,
+                                               std::string* why_not) {
   auto fail = [&](const std::string& why) -> std::unique_ptr<EglContext> {
     if (why_not) *why_not = why;
     return nullptr;
   };
-  const char* force = std::getenv("TISSUE_FORCE_NO_EGL");
-  if (force && std::string(force) == "1")
-    return fail("GL backend disabled by TISSUE_FORCE_NO_EGL=1");
+  if (options.disabled) return fail("GL backend disabled (option; TISSUE_FORCE_NO_EGL=1)");
 
   // Client extensions (EGL_NO_DISPLAY query needs EGL 1.5 or EGL_EXT_client_extensions).
   const char* client_ext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
@@ -156,9 +155,8 @@ std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
     const char* disp_ext = eglQueryString(c.display, EGL_EXTENSIONS);
     const bool surfaceless = has_extension(disp_ext, "EGL_KHR_surfaceless_context");
     // Desktop GL 4.3 core first (texelFetch loops, integer textures); GLES 3.2 otherwise.
-    // TISSUE_GL_API=gles skips desktop GL (to test the GLES shader path on any driver).
-    const char* api_env = std::getenv("TISSUE_GL_API");
-    const bool gles_only = api_env && std::string(api_env) == "gles";
+    // options.gles_only skips desktop GL (to test the GLES shader path on any driver).
+    const bool gles_only = options.gles_only;
     for (GlApi api : {GlApi::DesktopCore, GlApi::Gles32}) {
       const bool desktop = api == GlApi::DesktopCore;
       if (desktop && gles_only) continue;

@@ -5,6 +5,8 @@
 // EGL_PLATFORM_SURFACELESS_MESA platform. On each display: desktop GL 4.3+ core, else GLES 3.2.
 #pragma once
 
+#include "soft_tissue_cutting/gpu/gl_context_options.hpp"
+
 #include <memory>
 #include <string>
 
@@ -16,9 +18,9 @@ enum class GlApi { DesktopCore, Gles32 };
 class EglContext {
  public:
   // Null when no EGL driver/device gives a usable context; *why_not (if given) then holds one
-  // line saying why, so the caller can fall back to the CPU solver. TISSUE_FORCE_NO_EGL=1 forces
-  // this path (tests of the fallback); TISSUE_GL_API=gles skips desktop GL.
-  static std::unique_ptr<EglContext> create(std::string* why_not);
+  // line saying why, so the caller can fall back to the CPU solver. options.disabled forces this
+  // path (tests of the fallback); options.gles_only skips desktop GL.
+  static std::unique_ptr<EglContext> create(const GlContextOptions& options, std::string* why_not);
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;

@@ -19,7 +19,7 @@ class GlSolver final : public LinearSolver {
  public:
   GlSolver(std::unique_ptr<gpu::EglContext> ctx, const GlSolverOptions& options)
       : options_(options), ctx_(std::move(ctx)) {
-    shaders_ = std::make_unique<gpu::ShaderLibrary>(ctx_->api());
+    shaders_ = std::make_unique<gpu::ShaderLibrary>(ctx_->api(), options.context.shader_dir);
     runner_ = std::make_unique<gpu::PassRunner>(*shaders_);
     spmv_ = std::make_unique<gpu::GlSpmv>(*runner_);
     cg_ = std::make_unique<gpu::GlCg>(*runner_, *spmv_);
@@ -223,7 +223,7 @@ std::unique_ptr<LinearSolver> make_gl_solver(std::string* why_not) {
 }
 
 std::unique_ptr<LinearSolver> make_gl_solver(const GlSolverOptions& options, std::string* why_not) {
-  std::unique_ptr<gpu::EglContext> ctx = gpu::EglContext::create(why_not);
+  std::unique_ptr<gpu::EglContext> ctx = gpu::EglContext::create(options.context, why_not);
   if (!ctx) return nullptr;
   try {
     auto solver = std::make_unique<GlSolver>(std::move(ctx), options);

@@ -38,9 +38,9 @@ std::string version_header(GlApi api) {
 
 }  // namespace
 
-std::string find_shader_file(const std::string& file) {
+std::string find_shader_file(const std::string& file, const std::string& first_dir) {
   std::vector<std::string> dirs;
-  if (const char* env = std::getenv("TISSUE_SHADER_DIR")) dirs.push_back(env);
+  if (!first_dir.empty()) dirs.push_back(first_dir);
 #ifdef TISSUE_SOURCE_SHADER_DIR
   dirs.push_back(TISSUE_SOURCE_SHADER_DIR);
 #endif
@@ -62,7 +62,7 @@ ShaderLibrary::~ShaderLibrary() {
 }
 
 unsigned ShaderLibrary::compile(unsigned stage, const std::string& file) {
-  const std::string path = find_shader_file(file);
+  const std::string path = find_shader_file(file, shader_dir_);
   const std::string src = version_header(api_) + "#line 1\n" + read_file(path);
   const GLuint sh = glCreateShader(stage);
   const char* ptr = src.c_str();

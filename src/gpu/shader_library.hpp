@@ -1,7 +1,7 @@
 // GLSL programs of the texture CG (docs/DESIGN.md section 9: "a fragment program run over a quad").
 // Sources live in shaders/*.glsl without a #version line; the library prepends the one that
 // fits the context (desktop "430 core" or GLES "320 es" + precision), so one file serves both.
-// Search order for the folder: $TISSUE_SHADER_DIR, TISSUE_SOURCE_SHADER_DIR (build tree),
+// Search order for the folder: GlContextOptions::shader_dir, TISSUE_SOURCE_SHADER_DIR (build tree),
 // TISSUE_INSTALL_SHADER_DIR (installed package). Each program compiles once per context.
 #pragma once
 
@@ -9,16 +9,20 @@
 
 #include <map>
 #include <string>
+#include <utility>
 
 namespace stc {
 namespace gpu {
 
-// The first folder of the search order that holds `file`; throws with the folders tried.
-std::string find_shader_file(const std::string& file);
+// The first folder of the search order (`first_dir` if not empty, then the build tree, then the
+// install prefix) that holds `file`; throws with the folders tried.
+std::string find_shader_file(const std::string& file, const std::string& first_dir = "");
 
 class ShaderLibrary {
  public:
-  explicit ShaderLibrary(GlApi api) : api_(api) {}
+  // shader_dir: searched first (GlContextOptions::shader_dir; empty: none).
+  ShaderLibrary(GlApi api, std::string shader_dir)
+      : api_(api), shader_dir_(std::move(shader_dir)) {}
   ~ShaderLibrary();
   ShaderLibrary(const ShaderLibrary&) = delete;
   ShaderLibrary& operator=(const ShaderLibrary&) = delete;
@@ -31,6 +35,7 @@ class ShaderLibrary {
  private:
   unsigned compile(unsigned stage, const std::string& file);
   GlApi api_;
+  std::string shader_dir_;
   std::map<std::string, unsigned> programs_;
   std::map<std::pair<unsigned, std::string>, int> uniforms_;
 };

@@ -2,6 +2,7 @@
 list(APPEND TISSUE_CORE_SOURCES
   src/gpu/egl_context.cpp
   src/gpu/gl_cg.cpp
+  src/gpu/gl_context_options.cpp
   src/gpu/gl_pass.cpp
   src/gpu/gl_reduction.cpp
   src/gpu/gl_solver.cpp

@@ -25,6 +25,8 @@ void LoopMonitor::step_started(Clock::time_point t) {
 
 void LoopMonitor::step_finished(Clock::time_point t, bool converged) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // The gap this finish closes (a stall that ended before the next report still counts).
+  longest_gap_since_report_s_ = std::max(longest_gap_since_report_s_, seconds(t - last_finished_));
   const Clock::time_point start = in_progress_ ? in_progress_since_ : t;
   const double ms = 1000.0 * seconds(t - start);
   in_progress_ = false;
@@ -33,6 +35,8 @@ void LoopMonitor::step_finished(Clock::time_point t, bool converged) {
   if (ms > period_ms_) ++slow_steps_;
   worst_ever_ms_ = std::max(worst_ever_ms_, ms);
   converged_ = converged;
+  if (!converged) ++unconverged_since_report_;
+  worst_since_report_ms_ = std::max(worst_since_report_ms_, ms);
   window_.push_back({start, ms});
   prune_locked(t);
 }
@@ -43,11 +47,34 @@ void LoopMonitor::prune_locked(Clock::time_point now) const {
 
 LoopHealth LoopMonitor::health(Clock::time_point now) const {
   std::lock_guard<std::mutex> lock(mutex_);
+  LoopHealth h = health_locked(now);
+  classify(h, h.stalled);
+  return h;
+}
+
+LoopHealth LoopMonitor::report(Clock::time_point now) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  LoopHealth h = health_locked(now);
+  const bool stalled_now = h.stalled;
+  h.unconverged_steps = unconverged_since_report_;
+  h.converged = converged_ && unconverged_since_report_ == 0;
+  h.worst_step_ms = std::max(h.worst_step_ms, worst_since_report_ms_);
+  h.longest_gap_s = std::max(longest_gap_since_report_s_, h.since_last_step_s);
+  h.stalled = h.longest_gap_s > stall_after_s_;
+  classify(h, stalled_now);
+  unconverged_since_report_ = 0;
+  worst_since_report_ms_ = 0;
+  longest_gap_since_report_s_ = 0;
+  return h;
+}
+
+LoopHealth LoopMonitor::health_locked(Clock::time_point now) const {
   prune_locked(now);
   LoopHealth h;
   h.steps = steps_;
   h.slow_steps = slow_steps_;
   h.converged = converged_;
+  h.unconverged_steps = converged_ ? 0 : 1;
   h.worst_step_ms_ever = worst_ever_ms_;
   for (const Step& s : window_) h.worst_step_ms = std::max(h.worst_step_ms, s.ms);
   if (in_progress_) {
@@ -58,16 +85,30 @@ LoopHealth LoopMonitor::health(Clock::time_point now) const {
   const double age = std::max(1e-9, seconds(now - started_));
   h.rate_hz = static_cast<double>(window_.size()) / std::min(1.0, age);
   h.since_last_step_s = seconds(now - last_finished_);
+  h.longest_gap_s = h.since_last_step_s;
   h.stalled = h.since_last_step_s > stall_after_s_;
+  return h;
+}
 
+// Level and summary from the fields (stalled_now: the stall is still going on).
+void LoopMonitor::classify(LoopHealth& h, bool stalled_now) const {
   char buf[200];
   if (h.stalled) {
     h.level = LoopHealth::kError;
-    std::snprintf(buf, sizeof buf, "loop stalled: no step finished for %.2f s",
-                  h.since_last_step_s);
+    if (stalled_now)
+      std::snprintf(buf, sizeof buf, "loop stalled: no step finished for %.2f s",
+                    h.since_last_step_s);
+    else
+      std::snprintf(buf, sizeof buf,
+                    "loop stalled since the last report: no step finished for %.2f s",
+                    h.longest_gap_s);
   } else if (!h.converged) {
     h.level = LoopHealth::kError;
-    std::snprintf(buf, sizeof buf, "solver did not converge");
+    if (h.unconverged_steps > 1)
+      std::snprintf(buf, sizeof buf, "solver did not converge (%llu steps since the last report)",
+                    static_cast<unsigned long long>(h.unconverged_steps));
+    else
+      std::snprintf(buf, sizeof buf, "solver did not converge");
   } else if (h.worst_step_ms > period_ms_ || h.rate_hz < 0.9 * target_rate_) {
     h.level = LoopHealth::kWarn;
     std::snprintf(buf, sizeof buf,
@@ -79,7 +120,6 @@ LoopHealth LoopMonitor::health(Clock::time_point now) const {
                   h.worst_step_ms);
   }
   h.summary = buf;
-  return h;
 }
 
 }  // namespace ros_io

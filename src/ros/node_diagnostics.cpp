@@ -1,6 +1,8 @@
-// /diagnostics from its own thread: LoopMonitor (worst step and rate over the last second,
-// stalls) plus the backend in use. It never takes the simulation lock, so it keeps publishing
-// while the simulation is busy, and a stalled loop shows up as an ERROR.
+// /diagnostics from its own thread: LoopMonitor::report (worst step and rate over the last
+// second, widened to everything since the previous publish: any non-converged solve, slow step
+// or stall in between is reported once) plus the backend in use. It never takes the simulation
+// lock, so it keeps publishing while the simulation is busy, and a stalled loop shows up as an
+// ERROR.
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
 #include <algorithm>
@@ -29,7 +31,7 @@ void TissueNode::remember_solver_failure(const std::string& why) {
 }
 
 void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  const LoopHealth h = monitor_.health(LoopMonitor::Clock::now());
+  const LoopHealth h = monitor_.report(LoopMonitor::Clock::now());
   std::string backend, renderer, note, failure, solved_by, fallback;
   std::optional<RegionMoveStats> moves;
   {
@@ -55,8 +57,10 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("steps over the period", h.slow_steps);
   status.add("since last step (s)", h.since_last_step_s);
   status.add("step in progress for (s)", h.busy_step_s);
-  status.add("stalled", h.stalled);
-  status.add("solver converged", h.converged);
+  status.add("longest gap since last report (s)", h.longest_gap_s);
+  status.add("stalled", h.stalled);             // now, or at any time since the last report
+  status.add("solver converged", h.converged);  // every solve since the last report
+  status.add("non-converged solves since last report", h.unconverged_steps);
   status.add("backend", backend);
   status.add("renderer", renderer);
   status.add("backend note", note);

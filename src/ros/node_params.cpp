@@ -15,7 +15,8 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("frame_id", p.frame_id, p.frame_id);
   pnh.param<double>("rate", p.rate, p.rate);
   pnh.param<std::string>("scalpel_frame", p.scalpel_frame, p.scalpel_frame);
-  pnh.param<std::string>("backend", p.backend, p.backend);
+  std::string backend;  // empty: the scene's
+  pnh.param<std::string>("backend", backend, backend);
   pnh.param<double>("max_pose_jump", p.max_pose_jump, p.max_pose_jump);
   pnh.param<int>("pose_rearm_count", p.pose_rearm_count, p.pose_rearm_count);
   pnh.param<double>("display_rate", p.display_rate, p.display_rate);
@@ -29,11 +30,10 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   if (pnh.hasParam("parent_transform") &&
       (!pnh.getParam("parent_transform", p.parent_transform) || p.parent_transform.size() != 7))
     throw std::runtime_error("~parent_transform must be a list of 7 numbers: x y z qx qy qz qw");
-  for (double v : p.parent_transform)
-    if (!std::isfinite(v)) throw std::runtime_error("~parent_transform has a non-finite number");
-  const auto& q = p.parent_transform;
-  if (!(q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6] > 0))
-    throw std::runtime_error("~parent_transform has a zero quaternion");
+  const auto& v = p.parent_transform;
+  const std::string problem =
+      pose_problem(Vec3(v[0], v[1], v[2]), Eigen::Vector4d(v[3], v[4], v[5], v[6]));
+  if (!problem.empty()) throw std::runtime_error("~parent_transform: " + problem);
   if (!(p.rate > 0) || !std::isfinite(p.rate))
     throw std::runtime_error("~rate must be a positive number of steps per second");
   if (!(p.max_pose_jump > 0)) throw std::runtime_error("~max_pose_jump must be positive (m)");
@@ -41,8 +41,12 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   if (!(p.display_rate > 0)) throw std::runtime_error("~display_rate must be positive (Hz)");
   if (p.max_cut_poses < 2) throw std::runtime_error("~max_cut_poses must be at least 2");
   if (!(p.max_cut_length > 0)) throw std::runtime_error("~max_cut_length must be positive (m)");
-  if (p.backend != "" && p.backend != "cpu" && p.backend != "gl")
-    throw std::runtime_error("~backend must be cpu or gl, not '" + shorten(p.backend) + "'");
+  if (!backend.empty()) {
+    p.backend = parse_backend(backend);
+    if (!p.backend)
+      throw std::runtime_error(std::string("~backend must be ") + kBackendChoices + ", not '" +
+                               shorten(backend) + "'");
+  }
   p.frame_id = strip_slash(p.frame_id);
   if (p.frame_id.empty()) throw std::runtime_error("~frame_id must not be empty");
   return p;

@@ -17,7 +17,7 @@ void TissueNode::publish_step_locked(const StepStats& s, const std::optional<Bla
   // backend: what actually solved (cpu when a gl solve fell back).
   soft_tissue_cutting::SimStats stats =
       to_stats_msg(s, sim_->counts(), s.solved_by.empty() ? sim_->backend() : s.solved_by,
-                   sim_->renderer(), rate_hz);
+                   sim_->renderer(), rate_hz, last_recovery_ms_);
   stats.header.stamp = stamp;
   stats.header.frame_id = params_.frame_id;
   stats_pub_.publish(stats);
@@ -56,8 +56,16 @@ void TissueNode::publish_display_locked(const StepStats& s, const ros::Time& sta
     publish_markers_locked(stamp);
 }
 
+DeformedSurface TissueNode::timed_surface_locked() {
+  const auto t0 = std::chrono::steady_clock::now();
+  DeformedSurface s = sim_->surface();  // recovers u_S from u_I if it is stale
+  last_recovery_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return s;
+}
+
 void TissueNode::publish_surface_locked(const ros::Time& stamp) {
-  const DeformedSurface s = sim_->surface();
+  const DeformedSurface s = timed_surface_locked();
   visualization_msgs::Marker m = surface_marker(s, SurfacePart::kAll);
   m.header.frame_id = params_.frame_id;
   m.header.stamp = stamp;
@@ -82,7 +90,7 @@ void TissueNode::publish_surface_locked(const ros::Time& stamp) {
 
 void TissueNode::publish_markers_locked(const ros::Time& stamp, const DeformedSurface* surface) {
   visualization_msgs::MarkerArray array;
-  const DeformedSurface s = surface ? *surface : sim_->surface();
+  const DeformedSurface s = surface ? *surface : timed_surface_locked();
   array.markers.push_back(surface_marker(s, SurfacePart::kSkin));
   array.markers.push_back(surface_marker(s, SurfacePart::kCut));
   for (auto& m : operation_region_markers(sim_->scene().operation_region).markers)

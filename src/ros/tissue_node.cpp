@@ -125,11 +125,12 @@ void TissueNode::publish_parent_frame() {
   t.transform.translation.x = v[0];
   t.transform.translation.y = v[1];
   t.transform.translation.z = v[2];
-  const double n = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
-  t.transform.rotation.x = v[3] / n;  // read_params refused a zero quaternion
-  t.transform.rotation.y = v[4] / n;
-  t.transform.rotation.z = v[5] / n;
-  t.transform.rotation.w = v[6] / n;
+  // read_params refused a zero quaternion (pose_problem)
+  const Eigen::Quaterniond q = unit_quaternion(Eigen::Vector4d(v[3], v[4], v[5], v[6]));
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
   frame_broadcaster_.sendTransform(t);
 }
 

@@ -3,7 +3,9 @@
 
 #include <ros/ros.h>
 
+#include <cstdlib>
 #include <exception>
+#include <string>
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "tissue");
@@ -20,6 +22,19 @@ int main(int argc, char** argv) {
   }
   try {
     options.backend = params.backend;
+    // The gl switches of the environment (docs/ROS.md), read here: the core reads none.
+    options.gl = stc::gl_context_options_from(std::getenv("TISSUE_FORCE_NO_EGL"),
+                                              std::getenv("TISSUE_GL_API"),
+                                              std::getenv("TISSUE_SHADER_DIR"));
+    // The core's messages go to rosconsole (and /rosout).
+    options.log = [](stc::LogLevel level, const std::string& message) {
+      if (level == stc::LogLevel::kError)
+        ROS_ERROR("%s", message.c_str());
+      else if (level == stc::LogLevel::kWarn)
+        ROS_WARN("%s", message.c_str());
+      else
+        ROS_INFO("%s", message.c_str());
+    };
     scene = stc::ros_io::load_scene_param(params.scene);
     sim = std::make_unique<stc::Simulation>(scene, options);
   } catch (const std::exception& e) {

@@ -338,12 +338,11 @@ class SceneLoader {
       pose.position = f_.vec3(p["position"], key + ".position");
       if (p["orientation"]) {
         const auto q = f_.numbers(p["orientation"], key + ".orientation", 4);  // qx qy qz qw
-        Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-        const double norm = quat.norm();
-        if (!(norm > 1e-12) || !std::isfinite(norm))
-          f_.fail(p["orientation"], key + ".orientation", "zero quaternion (not a rotation)");
-        quat.coeffs() /= norm;
-        pose.orientation = quat;
+        const Eigen::Vector4d xyzw(q[0], q[1], q[2], q[3]);
+        const std::string problem = pose_problem(pose.position, xyzw);
+        if (!problem.empty())
+          f_.fail(p["orientation"], key + ".orientation", problem + " (not a rotation)");
+        pose.orientation = unit_quaternion(xyzw);
       }
       scene_.trajectory.push_back(pose);
     }
@@ -353,9 +352,11 @@ class SceneLoader {
     f_.check_map(n, "solver", {"backend", "tolerance", "max_iterations"});
     if (n["backend"]) {
       const std::string b = f_.string(n["backend"], "solver.backend");
-      if (b != "cpu" && b != "gl")
-        f_.fail(n["backend"], "solver.backend", "must be cpu or gl, got '" + b + "'");
-      scene_.solver.backend = b;
+      const std::optional<Backend> backend = parse_backend(b);
+      if (!backend)
+        f_.fail(n["backend"], "solver.backend",
+                std::string("must be ") + kBackendChoices + ", got '" + b + "'");
+      scene_.solver.backend = *backend;
     }
     if (n["tolerance"]) scene_.solver.tolerance = f_.positive(n["tolerance"], "solver.tolerance");
     if (n["max_iterations"])

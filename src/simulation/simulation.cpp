@@ -96,28 +96,25 @@ struct Simulation::Impl {
   StepStats last;
   StepTimes step_times;  // every step() since start(), by kind (stats JSON step_ms)
 
-  std::string requested_backend() const {
-    return options.backend.empty() ? scene.solver.backend : options.backend;
-  }
+  Backend requested_backend() const { return options.backend.value_or(scene.solver.backend); }
 
   // ~cut paths are resampled at this spacing (docs/DESIGN.md (cutting)): the median edge of
   // the initial operation part, so one sweep per element size whatever the caller's sampling.
   double cut_spacing = 0;
 
   std::unique_ptr<LinearSolver> make_solver() {
-    const std::string wanted = requested_backend();
     backend = "cpu";
     renderer.clear();
-    if (wanted == "gl") {
+    if (requested_backend() == Backend::kGl) {
       std::string why;
-      if (auto gl = make_gl_solver(&why)) {
+      GlSolverOptions gl_options;
+      gl_options.context = options.gl;
+      if (auto gl = make_gl_solver(gl_options, &why)) {
         backend = "gl";
         renderer = gl->renderer();
         return gl;
       }
       backend_note = "gl backend unavailable (" + why + "); solving on the cpu";
-    } else if (wanted != "cpu") {
-      throw std::invalid_argument("solver.backend: '" + wanted + "' is not cpu or gl");
     }
     return make_cpu_solver();
   }
@@ -239,9 +236,9 @@ struct Simulation::Impl {
         anchored[static_cast<size_t>(n)] = 1;
       }
       ++free_pieces_held;
-      std::fprintf(stderr,
-                   "soft_tissue_cutting: a piece of %zu tets was cut free; it is held in place\n",
-                   piece.tets.size());
+      if (options.log)
+        options.log(LogLevel::kInfo, "a piece of " + std::to_string(piece.tets.size()) +
+                                         " tets was cut free; it is held in place");
     }
   }
 
@@ -513,15 +510,8 @@ Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl)
 
 Simulation::~Simulation() = default;
 
-namespace {
-bool finite_pose(const BladePose& p) {
-  return p.position.allFinite() && p.orientation.coeffs().allFinite() &&
-         p.orientation.coeffs().squaredNorm() > 1e-12;
-}
-}  // namespace
-
 StepStats Simulation::step(const std::optional<BladePose>& blade) {
-  if (blade && !finite_pose(*blade))
+  if (blade && !pose_problem(*blade).empty())
     throw std::invalid_argument("blade pose is not finite (NaN/Inf or a zero quaternion)");
   std::optional<BladePose> normalized = blade;
   if (normalized) normalized->orientation.normalize();
@@ -550,7 +540,7 @@ PathCut Simulation::begin_path_cut(const std::vector<BladePose>& poses) const {
     return cut;
   }
   for (size_t i = 0; i < poses.size(); ++i)
-    if (!finite_pose(poses[i])) {
+    if (!pose_problem(poses[i]).empty()) {
       cut.refusal = "pose " + std::to_string(i) + " is not finite (NaN/Inf) or a zero quaternion";
       return cut;
     }
@@ -645,14 +635,8 @@ DeformedSurface Simulation::surface() const {
 std::uint64_t Simulation::surface_version() const { return impl_->surface_version; }
 
 ModelCounts Simulation::counts() const {
-  const HybridModelCounts h = impl_->model->counts();
   ModelCounts c;
-  c.nodes = h.nodes;
-  c.tets = h.tets;
-  c.dof_operation = h.dof_operation;
-  c.nodes_interface = h.nodes_interface;
-  c.nodes_surface_condensed = h.nodes_surface_condensed;
-  c.nodes_interior_condensed = h.nodes_interior_condensed;
+  static_cast<HybridModelCounts&>(c) = impl_->model->counts();
   c.cuts = impl_->cuts;
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
@@ -667,7 +651,9 @@ const StepStats& Simulation::last_stats() const { return impl_->last; }
 std::string Simulation::backend() const { return impl_->backend; }
 std::string Simulation::renderer() const { return impl_->renderer; }
 std::string Simulation::backend_note() const { return impl_->backend_note; }
-std::string Simulation::backend_requested() const { return impl_->requested_backend(); }
+std::string Simulation::backend_requested() const {
+  return backend_name(impl_->requested_backend());
+}
 std::vector<std::uint8_t> Simulation::tet_regions() const {
   return impl_->model->partition().operation_tet;
 }

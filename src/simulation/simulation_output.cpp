@@ -1,6 +1,7 @@
 // The offline outputs of docs/SCENE.md "Offline run": the VTK state and the JSON statistics.
 #include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
+#include "soft_tissue_cutting/simulation/model_counts_json.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
 
@@ -34,12 +35,7 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   const ModelCounts c = counts();
   const StepStats& s = last_stats();
   nlohmann::ordered_json j;
-  j["nodes"] = c.nodes;
-  j["tets"] = c.tets;
-  j["dof_operation"] = c.dof_operation;
-  j["nodes_interface"] = c.nodes_interface;
-  j["nodes_surface_condensed"] = c.nodes_surface_condensed;
-  j["nodes_interior_condensed"] = c.nodes_interior_condensed;
+  add_model_sizes(j, c);
   j["cuts"] = c.cuts;
   j["tets_split"] = c.tets_split;
   j["free_pieces_held"] = c.free_pieces_held;

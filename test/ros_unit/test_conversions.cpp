@@ -73,7 +73,6 @@ TEST(Conversions, SimStatsCarriesEveryField) {
   s.cutting_ms = 1.5;
   s.assembly_ms = 2.5;
   s.solve_ms = 3.5;
-  s.recovery_ms = 4.5;
   s.step_ms = 12.5;
   ModelCounts c;
   c.nodes = 100;
@@ -84,7 +83,7 @@ TEST(Conversions, SimStatsCarriesEveryField) {
   c.nodes_interior_condensed = 13;
   c.cuts = 4;
   c.tets_split = 25;
-  const soft_tissue_cutting::SimStats m = to_stats_msg(s, c, "gl", "llvmpipe", 97.5);
+  const soft_tissue_cutting::SimStats m = to_stats_msg(s, c, "gl", "llvmpipe", 97.5, 4.5);
   EXPECT_EQ(m.step, 42u);
   EXPECT_EQ(m.backend, "gl");
   EXPECT_EQ(m.renderer, "llvmpipe");

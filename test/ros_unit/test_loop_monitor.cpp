@@ -84,6 +84,75 @@ TEST(LoopMonitor, NotConvergedIsAnError) {
   EXPECT_EQ(h.summary, "solver did not converge");
 }
 
+// report(): what /diagnostics publishes covers everything since the previous report, so a
+// failure that is over by the time of the publish is still an ERROR, once.
+TEST(LoopMonitor, ReportKeepsANonConvergedSolveBetweenPublishes) {
+  LoopMonitor m(100, t(0));
+  double end = run(m, 0, 100, 10, 4);
+  EXPECT_EQ(m.report(t(end)).level, LoopHealth::kOk);
+  end = run(m, end, 10, 10, 4);
+  end = run(m, end, 1, 10, 4, false);  // one failed solve, then 50 good steps
+  end = run(m, end, 50, 10, 4);
+  EXPECT_EQ(m.health(t(end)).level, LoopHealth::kOk);  // the last step's view misses it
+  LoopHealth h = m.report(t(end));
+  EXPECT_EQ(h.level, LoopHealth::kError) << h.summary;
+  EXPECT_FALSE(h.converged);
+  EXPECT_EQ(h.unconverged_steps, 1u);
+  EXPECT_EQ(h.summary, "solver did not converge");
+  end = run(m, end, 3, 10, 4, false);
+  h = m.report(t(end));
+  EXPECT_EQ(h.unconverged_steps, 3u);
+  EXPECT_EQ(h.summary, "solver did not converge (3 steps since the last report)");
+  end = run(m, end, 100, 10, 4);
+  h = m.report(t(end));  // reported once: the next interval is clean
+  EXPECT_EQ(h.level, LoopHealth::kOk) << h.summary;
+  EXPECT_TRUE(h.converged);
+  EXPECT_EQ(h.unconverged_steps, 0u);
+}
+
+TEST(LoopMonitor, ReportKeepsAStallThatEndedBeforeThePublish) {
+  LoopMonitor m(100, t(0));
+  double end = run(m, 0, 100, 10, 4);
+  EXPECT_EQ(m.report(t(end)).level, LoopHealth::kOk);
+  m.step_started(t(end));
+  m.step_finished(t(end + 1500), true);  // 1.5 s without a finished step
+  end = run(m, end + 1500, 150, 10, 4);  // then 1.5 s at the full rate
+  EXPECT_EQ(m.health(t(end)).level, LoopHealth::kOk);
+  LoopHealth h = m.report(t(end));
+  EXPECT_EQ(h.level, LoopHealth::kError) << h.summary;
+  EXPECT_TRUE(h.stalled);
+  EXPECT_NEAR(h.longest_gap_s, 1.506, 1e-6);  // from the last finish at end - 6 ms
+  EXPECT_NEAR(h.worst_step_ms, 1500, 1e-6);
+  EXPECT_NE(h.summary.find("loop stalled since the last report"), std::string::npos) << h.summary;
+  end = run(m, end, 100, 10, 4);
+  h = m.report(t(end));
+  EXPECT_EQ(h.level, LoopHealth::kOk) << h.summary;
+  EXPECT_FALSE(h.stalled);
+}
+
+TEST(LoopMonitor, ReportKeepsASlowStepOlderThanOneSecond) {
+  LoopMonitor m(100, t(0));
+  double end = run(m, 0, 100, 10, 4);
+  EXPECT_EQ(m.report(t(end)).level, LoopHealth::kOk);
+  m.step_started(t(end));
+  m.step_finished(t(end + 40), true);
+  end = run(m, end + 40, 200, 10, 4);  // 2 s later: out of the one-second window
+  EXPECT_EQ(m.health(t(end)).level, LoopHealth::kOk);
+  const LoopHealth h = m.report(t(end));
+  EXPECT_EQ(h.level, LoopHealth::kWarn) << h.summary;
+  EXPECT_NEAR(h.worst_step_ms, 40, 1e-6);
+}
+
+TEST(LoopMonitor, ReportStaysAnErrorWhileTheLastSolveFailed) {
+  LoopMonitor m(100, t(0));
+  double end = run(m, 0, 20, 10, 4, false);
+  EXPECT_EQ(m.report(t(end)).level, LoopHealth::kError);
+  // No step since (the loop is busy in a step): the last solve's failure still stands.
+  const LoopHealth h = m.report(t(end + 5));
+  EXPECT_EQ(h.level, LoopHealth::kError) << h.summary;
+  EXPECT_EQ(h.unconverged_steps, 0u);
+}
+
 TEST(LoopMonitor, YoungMonitorRatesOverItsAge) {
   LoopMonitor m(100, t(0));
   const double end = run(m, 0, 50, 10, 4);  // 0.5 s old

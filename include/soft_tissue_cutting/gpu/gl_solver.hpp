@@ -14,6 +14,7 @@
 // max_iterations is not a fallback: the solve is reported not converged.
 #pragma once
 
+#include "soft_tissue_cutting/gpu/gl_context_options.hpp"
 #include "soft_tissue_cutting/gpu/matrix_layout.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 
@@ -39,9 +40,10 @@ struct GlSolverOptions {
   // Texture size limit for the matrix layout; 0: the device's GL_MAX_TEXTURE_SIZE (tests set
   // a small one to exercise the too-big-for-textures fallback, which ignores cpu_fallback).
   int max_texture_size = 0;
+  GlContextOptions context;  // EGL context and shader folder
 };
 
-// Null when no GL context can be made (no EGL driver/device, or TISSUE_FORCE_NO_EGL=1);
+// Null when no GL context can be made (no EGL driver/device, or options.context.disabled);
 // *why_not then says why in one line, so the caller falls back to make_cpu_solver().
 std::unique_ptr<LinearSolver> make_gl_solver(std::string* why_not);
 std::unique_ptr<LinearSolver> make_gl_solver(const GlSolverOptions& options, std::string* why_not);

@@ -20,12 +20,14 @@ geometry_msgs::Pose to_pose_msg(const BladePose& pose);
 // Why `pose` cannot be a blade pose: "not finite (NaN/Inf)", "zero quaternion", or "" when it
 // can. One check for the topic, tf2 and ~cut inputs.
 std::string pose_problem(const geometry_msgs::Pose& pose);
-std::string pose_problem(const BladePose& pose);
+using stc::pose_problem;  // the BladePose overload (scene.hpp)
 
-// One step's SimStats: StepStats + sizes of the current state + backend in use.
+// One step's SimStats: StepStats + sizes of the current state + backend in use. recovery_ms:
+// the node's last ~surface refresh (Simulation::surface(), which recovers the condensed
+// surface on demand; not part of a step), 0 before the first.
 soft_tissue_cutting::SimStats to_stats_msg(const StepStats& step, const ModelCounts& counts,
                                            const std::string& backend, const std::string& renderer,
-                                           double rate_hz);
+                                           double rate_hz, double recovery_ms);
 
 // Force and torque about the blade tip on the blade; in the tissue frame, or in the blade's
 // axes (x along the edge, y its normal) when `blade_axes` gives the blade pose.

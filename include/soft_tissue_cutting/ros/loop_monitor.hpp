@@ -1,7 +1,10 @@
 // Health of the simulation loop for /diagnostics: every step is measured (start, duration,
-// converged), and the report covers the last second: achieved rate, worst step, and whether
-// the loop stalled. Thread-safe: the loop records, the diagnostics thread reports, and neither
-// takes the simulation lock, so a busy simulation is still reported (as stalled).
+// converged). health() is the view of the last second: achieved rate, worst step, and whether
+// the loop stalls now. report() is what /diagnostics publishes: the same view, widened to
+// everything since the previous report, so a non-converged solve, a slow step or a stall that
+// ended between two publishes still shows as ERROR/WARN once. Thread-safe: the loop records, the
+// diagnostics thread reports, and neither takes the simulation lock, so a busy simulation is still
+// reported (as stalled).
 #pragma once
 
 #include <chrono>
@@ -24,8 +27,14 @@ struct LoopHealth {
   double busy_step_s = 0;         // how long the step in progress has run (0 if none)
   std::uint64_t steps = 0;
   std::uint64_t slow_steps = 0;  // steps longer than the period, since start
-  bool converged = true;         // the last step's solve
-  bool stalled = false;
+  // health(): the last step's solve. report(): every solve since the previous report (and
+  // the last step's, so a persistent failure stays an ERROR).
+  bool converged = true;
+  std::uint64_t unconverged_steps = 0;  // report(): non-converged solves since the last report
+  double longest_gap_s = 0;  // report(): longest time without a finished step since the last
+                             // report (the gap still open included)
+  bool stalled = false;      // health(): stalls now; report(): stalled at any time since the
+                             // last report
 };
 
 class LoopMonitor {
@@ -38,6 +47,9 @@ class LoopMonitor {
   void step_started(Clock::time_point t);
   void step_finished(Clock::time_point t, bool converged);
   LoopHealth health(Clock::time_point now) const;
+  // health(now) over everything since the previous report (see LoopHealth), then starts a new
+  // reporting interval. For /diagnostics: one caller.
+  LoopHealth report(Clock::time_point now);
   double target_rate() const { return target_rate_; }
 
  private:
@@ -46,6 +58,8 @@ class LoopMonitor {
     double ms;
   };
   void prune_locked(Clock::time_point now) const;
+  LoopHealth health_locked(Clock::time_point now) const;
+  void classify(LoopHealth& h, bool stalled_now) const;
 
   mutable std::mutex mutex_;
   const double target_rate_;
@@ -58,7 +72,11 @@ class LoopMonitor {
   bool in_progress_ = false;
   std::uint64_t steps_ = 0, slow_steps_ = 0;
   double worst_ever_ms_ = 0;
-  bool converged_ = true;
+  bool converged_ = true;  // the last step's solve
+  // Since the last report().
+  std::uint64_t unconverged_since_report_ = 0;
+  double worst_since_report_ms_ = 0;
+  double longest_gap_since_report_s_ = 0;
 };
 
 }  // namespace ros_io

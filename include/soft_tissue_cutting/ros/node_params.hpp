@@ -15,11 +15,11 @@ struct NodeParams {
   std::string scene = "thigh";
   std::string frame_id = "tissue";
   double rate = 100.0;
-  std::string scalpel_frame;    // empty: poses come from the scalpel/pose topic
-  std::string backend;          // empty: the scene's solver.backend
-  double max_pose_jump = 0.05;  // m
-  int pose_rearm_count = 20;    // consecutive jump refusals before re-arming on the newest pose
-  double display_rate = 30.0;   // Hz, upper limit for ~surface / ~markers
+  std::string scalpel_frame;       // empty: poses come from the scalpel/pose topic
+  std::optional<Backend> backend;  // ~backend; nullopt: the scene's solver.backend
+  double max_pose_jump = 0.05;     // m
+  int pose_rearm_count = 20;       // consecutive jump refusals before re-arming on the newest pose
+  double display_rate = 30.0;      // Hz, upper limit for ~surface / ~markers
   // ~cut request limits: more poses, or a longer blade travel, is refused with a message.
   int max_cut_poses = 20000;
   double max_cut_length = 1.0;  // m of blade travel (cutting/blade_path)

@@ -96,6 +96,8 @@ class TissueNode {
   void publish_display_locked(const StepStats& s, const ros::Time& stamp);
   void publish_surface_locked(const ros::Time& stamp);
   void publish_markers_locked(const ros::Time& stamp, const DeformedSurface* surface = nullptr);
+  // sim_->surface(), its time kept for ~stats recovery_ms.
+  DeformedSurface timed_surface_locked();
 
   // services (node_services.cpp)
   bool on_cut(soft_tissue_cutting::Cut::Request& req, soft_tissue_cutting::Cut::Response& res);
@@ -162,6 +164,7 @@ class TissueNode {
   std::string last_hash_;
   std::optional<BladePose> shown_blade_;  // blade in the last ~markers
   bool shown_cutting_ = false;
+  double last_recovery_ms_ = 0;  // the last ~surface/~markers refresh (recovery on demand)
 };
 
 }  // namespace ros_io

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+#include "soft_tissue_cutting/solve/backend.hpp"
 
 #include <Eigen/Geometry>
 
@@ -71,9 +72,17 @@ struct BladePose {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
+// The one check of a pose (scene trajectories, ~parent_transform, scalpel topic and tf2 poses,
+// ~cut paths, Simulation): why `position` + quaternion (x y z w) cannot be a pose: "not finite
+// (NaN/Inf)", "zero quaternion" (|q|^2 <= 1e-12, no rotation to normalise), or "" when it can.
+std::string pose_problem(const Vec3& position, const Eigen::Vector4d& quaternion_xyzw);
+std::string pose_problem(const BladePose& pose);
+// The rotation of a quaternion that passed pose_problem: q / |q|.
+Eigen::Quaterniond unit_quaternion(const Eigen::Vector4d& quaternion_xyzw);
+
 struct SolverParams {
-  std::string backend = "cpu";  // "cpu" or "gl"
-  double tolerance = 1e-10;     // relative residual ||b - Ax|| / ||b||
+  Backend backend = Backend::kCpu;
+  double tolerance = 1e-10;  // relative residual ||b - Ax|| / ||b||
   int max_iterations = 2000;
 };
 

@@ -15,6 +15,7 @@
 #include "soft_tissue_cutting/partition/partition.hpp"
 #include "soft_tissue_cutting/recovery/surface_recovery.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
+#include "soft_tissue_cutting/simulation/model_counts.hpp"  // HybridModelCounts
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 
 #include <chrono>
@@ -28,14 +29,6 @@ namespace stc {
 
 // Imposed displacements: node -> displacement (scalpel contact, held free pieces).
 using ImposedDisplacements = std::map<int, Vec3>;
-
-// Sizes for the stats (docs/SCENE.md "Offline run"); fixed nodes count in their set.
-struct HybridModelCounts {
-  int nodes = 0, tets = 0;
-  int dof_operation = 0;  // rows of the hybrid system: free DOFs of O u I
-  int nodes_operation = 0, nodes_interface = 0, nodes_surface_condensed = 0,
-      nodes_interior_condensed = 0;
-};
 
 class HybridModel {
  public:

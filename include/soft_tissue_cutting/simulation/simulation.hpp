@@ -3,11 +3,14 @@
 // and the offline `./tissue solve` both drive this class.
 #pragma once
 
+#include "soft_tissue_cutting/gpu/gl_context_options.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
+#include "soft_tissue_cutting/simulation/model_counts.hpp"  // ModelCounts
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -20,8 +23,16 @@ class HybridModel;
 struct RegionMoveStats;  // simulation/region_move_stats.hpp
 struct StepTimes;        // simulation/step_times.hpp
 
+// The core's log sink: where Simulation sends its messages (a free piece held, ...). The core
+// never writes to stderr itself: `tissue solve` prints them, tissue_node routes them to
+// rosconsole (so they reach /rosout). Empty: dropped.
+enum class LogLevel { kInfo, kWarn, kError };
+using LogSink = std::function<void(LogLevel level, const std::string& message)>;
+
 struct SimulationOptions {
-  std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
+  std::optional<Backend> backend;  // nullopt: the scene's solver.backend
+  GlContextOptions gl;             // the gl backend's context and shader folder
+  LogSink log;
   // `follow` region: a move requested at one step is awaited at the start of the next
   // (offline: deterministic, every run moves at the same steps). Off (online), the old model
   // runs until the worker has finished and the loop never blocks.
@@ -52,18 +63,9 @@ struct StepStats {
   // `follow` region: a re-condensation runs on the worker after this step (the cut waits),
   // or this step swapped the moved region's model in (region_follower.hpp).
   bool region_moving = false, region_moved = false;
-  double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
+  // No recovery_ms: a step never recovers the condensed surface (surface() does, on demand).
+  double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0;
   double step_ms = 0;
-};
-
-// Sizes of the current state (after cuts), as docs/SCENE.md "Offline run" names them.
-struct ModelCounts {
-  int nodes = 0, tets = 0, dof_operation = 0, nodes_interface = 0;
-  int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
-  int cuts = 0, tets_split = 0, free_pieces_held = 0;
-  long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
-  long solver_fallbacks = 0;     // gl solves finished on the cpu since the start (or reset)
-  double volume_initial = 0, volume_final = 0;
 };
 
 struct CutOutcome {

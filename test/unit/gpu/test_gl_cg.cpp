@@ -147,23 +147,38 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(GpuFallback, ForcedNoEglGivesNullAndOneLineReason) {
-  setenv("TISSUE_FORCE_NO_EGL", "1", 1);
+  GlSolverOptions options;
+  options.context.disabled = true;
   std::string why;
-  auto s = make_gl_solver(&why);
-  unsetenv("TISSUE_FORCE_NO_EGL");
+  auto s = make_gl_solver(options, &why);
   EXPECT_FALSE(s);
   EXPECT_FALSE(why.empty());
   EXPECT_EQ(why.find('\n'), std::string::npos);
   EXPECT_NE(why.find("TISSUE_FORCE_NO_EGL"), std::string::npos);
 }
 
-TEST(GpuFallback, BadShaderDirEnvFallsBackToBuildTree) {
-  // $TISSUE_SHADER_DIR comes first; the build-tree folder still serves as fallback.
-  setenv("TISSUE_SHADER_DIR", "/nonexistent/shaders", 1);
+TEST(GpuFallback, BadShaderDirFallsBackToBuildTree) {
+  // options.context.shader_dir comes first; the build-tree folder still serves as fallback.
+  GlSolverOptions options;
+  options.context.shader_dir = "/nonexistent/shaders";
   std::string why;
-  auto s = make_gl_solver(&why);
-  unsetenv("TISSUE_SHADER_DIR");
+  auto s = make_gl_solver(options, &why);
   EXPECT_TRUE(s) << why;
+}
+
+// The apps' environment switches map to the options in one place (the core reads none).
+TEST(GpuFallback, EnvironmentValuesMapToContextOptions) {
+  const GlContextOptions none = gl_context_options_from(nullptr, nullptr, nullptr);
+  EXPECT_FALSE(none.disabled);
+  EXPECT_FALSE(none.gles_only);
+  EXPECT_EQ(none.shader_dir, "");
+  const GlContextOptions all = gl_context_options_from("1", "gles", "/some/dir");
+  EXPECT_TRUE(all.disabled);
+  EXPECT_TRUE(all.gles_only);
+  EXPECT_EQ(all.shader_dir, "/some/dir");
+  const GlContextOptions other = gl_context_options_from("0", "gl", nullptr);
+  EXPECT_FALSE(other.disabled);
+  EXPECT_FALSE(other.gles_only);
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ struct Outcome {
 // Plays the scene as `tissue solve` does: trajectory, then the final equilibrium.
 Outcome play(const Scene& scene, const std::string& backend) {
   SimulationOptions options;
-  options.backend = backend;
+  options.backend = parse_backend(backend);
   Simulation sim(scene, options);
   EXPECT_EQ(sim.backend(), backend) << sim.backend_note();
   for (const BladePose& pose : scene.trajectory) {

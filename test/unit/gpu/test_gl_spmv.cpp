@@ -23,9 +23,9 @@ class GpuSpmv : public ::testing::TestWithParam<SpmvLayout> {
  protected:
   void SetUp() override {
     std::string why;
-    ctx_ = EglContext::create(&why);
+    ctx_ = EglContext::create(GlContextOptions{}, &why);
     ASSERT_TRUE(ctx_) << "EGL must work on llvmpipe here: " << why;
-    shaders_ = std::make_unique<ShaderLibrary>(ctx_->api());
+    shaders_ = std::make_unique<ShaderLibrary>(ctx_->api(), "");
     runner_ = std::make_unique<PassRunner>(*shaders_);
   }
   void TearDown() override {

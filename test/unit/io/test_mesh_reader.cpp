@@ -1,4 +1,4 @@
-// Every input format read correctly: each writer in test_io_util.hpp encodes the same box mesh,
+// Every input format read correctly: each writer in test/common/mesh_files.hpp encodes the same box mesh,
 // read_mesh must give it back exactly (node order = file order, tets positively oriented).
 #include "common/mesh_files.hpp"
 

@@ -77,7 +77,7 @@ TEST(SceneLoader, DefaultsAndScaleBeforeSelectors) {
   EXPECT_EQ(s.fixed[0].select(s.mesh).size(), 1u);
   EXPECT_NEAR(total_volume(s.mesh), 2.0 * 27, 1e-12);
   EXPECT_EQ(s.operation_region.kind, OperationRegion::Kind::kAll);
-  EXPECT_EQ(s.solver.backend, "cpu");
+  EXPECT_EQ(s.solver.backend, Backend::kCpu);
   EXPECT_DOUBLE_EQ(s.material.young_modulus, 3000.0);
   EXPECT_TRUE(s.trajectory.empty());
 }
@@ -279,6 +279,34 @@ TEST(SceneLoader, MissingSceneFileAndBadMeshNameTheFile) {
     EXPECT_EQ(std::string(e.what()),
               path + ":2: mesh.file: " + dir.file("bad.msh") + ":4: non-finite z coordinate 'nan'");
   }
+}
+
+// One backend parser for the scene, ~backend, `tissue solve --backend` and Simulation.
+TEST(SceneLoader, OneBackendParser) {
+  EXPECT_EQ(parse_backend("cpu"), Backend::kCpu);
+  EXPECT_EQ(parse_backend("gl"), Backend::kGl);
+  EXPECT_EQ(parse_backend("cuda"), std::nullopt);
+  EXPECT_EQ(parse_backend(""), std::nullopt);
+  EXPECT_EQ(parse_backend("CPU"), std::nullopt);
+  for (Backend b : {Backend::kCpu, Backend::kGl}) EXPECT_EQ(parse_backend(backend_name(b)), b);
+}
+
+// One pose check for trajectories, the node's poses and parent transform, and Simulation.
+TEST(SceneLoader, OnePoseCheck) {
+  const double nan = std::nan(""), inf = INFINITY;
+  EXPECT_EQ(pose_problem(Vec3(1, 2, 3), Eigen::Vector4d(0, 0, 0, 1)), "");
+  EXPECT_EQ(pose_problem(Vec3(1e300, 0, 0), Eigen::Vector4d(0, 0, 0, 2)), "");
+  EXPECT_EQ(pose_problem(Vec3(nan, 0, 0), Eigen::Vector4d(0, 0, 0, 1)), "not finite (NaN/Inf)");
+  EXPECT_EQ(pose_problem(Vec3(0, 0, 0), Eigen::Vector4d(0, inf, 0, 1)), "not finite (NaN/Inf)");
+  EXPECT_EQ(pose_problem(Vec3(0, 0, 0), Eigen::Vector4d(0, 0, 0, 0)), "zero quaternion");
+  EXPECT_EQ(pose_problem(Vec3(0, 0, 0), Eigen::Vector4d(0, 0, 0, 1e-7)), "zero quaternion");
+  BladePose b;
+  b.orientation.coeffs() << 0, 0, 0, 0;
+  EXPECT_EQ(pose_problem(b), "zero quaternion");
+  const Eigen::Quaterniond q = unit_quaternion(Eigen::Vector4d(0, 0, 3, 4));  // x y z w
+  EXPECT_NEAR(q.norm(), 1, 1e-15);
+  EXPECT_NEAR(q.z(), 0.6, 1e-15);
+  EXPECT_NEAR(q.w(), 0.8, 1e-15);
 }
 
 }  // namespace

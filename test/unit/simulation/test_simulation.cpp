@@ -137,8 +137,11 @@ TEST(SimulationPipeline, ResetIsIdenticalToAFreshStartAndReplaysAgree) {
 // after cuts: its textures are rebuilt when a cut changes the matrix (issue 5).
 TEST(SimulationPipeline, GlBackendMatchesCpuThroughCuts) {
   const Scene scene = make_thigh_scene();
-  Simulation cpu(scene, SimulationOptions{"cpu"});
-  Simulation gl(scene, SimulationOptions{"gl"});
+  SimulationOptions on_cpu, on_gl;
+  on_cpu.backend = Backend::kCpu;
+  on_gl.backend = Backend::kGl;
+  Simulation cpu(scene, on_cpu);
+  Simulation gl(scene, on_gl);
   ASSERT_EQ(gl.backend(), "gl") << gl.backend_note();
   EXPECT_FALSE(gl.renderer().empty());
   auto relative_difference = [&] {

@@ -85,7 +85,7 @@ TestScene liver() {
   s.operation_region.kind = OperationRegion::Kind::kSphere;
   s.operation_region.sphere = Sphere{t.site.point, 0.04};
   s.scalpel = ScalpelParams{0.02, 0.5};
-  s.solver = SolverParams{"cpu", 1e-12, 4000};
+  s.solver = SolverParams{Backend::kCpu, 1e-12, 4000};
   return t;
 }
 
