@@ -1,5 +1,5 @@
-// Every input format read correctly: each writer in test/common/mesh_files.hpp encodes the same box mesh,
-// read_mesh must give it back exactly (node order = file order, tets positively oriented).
+// Every input format read correctly: each writer in test/common/mesh_files.hpp encodes the same box
+// mesh, read_mesh must give it back exactly (node order = file order, tets positively oriented).
 #include "common/mesh_files.hpp"
 
 namespace stc {
