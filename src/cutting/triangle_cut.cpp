@@ -81,6 +81,7 @@ bool TriangleClassification::contains(const Vec3& p, double tol) const {
 }
 
 int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int v) {
+  if (is_on_stroke(state, v)) return 0;  // on the stroke's cut surface (cut_state.hpp)
   auto it = side_.find(v);
   if (it != side_.end()) return it->second;
   const double d = distance(mesh, v);
@@ -149,6 +150,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         // is split has t in [snap, 1 - snap].
         if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
           tri.set_on(s < 0.5 ? u : v);
+          set_on_stroke(state, s < 0.5 ? u : v);
           resnap = true;
           continue;
         }
@@ -179,6 +181,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         if (1 - s.t < best) best = 1 - s.t, nearest = s.b;
       }
       tri.set_on(nearest);
+      set_on_stroke(state, nearest);
       snapped = true;
     }
     if (!snapped) break;
@@ -190,6 +193,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
     tri.set_on(m);
+    set_on_stroke(state, m);
     NewNode node;
     node.index = m;
     node.kind = NewNode::Kind::kEdgeSplit;
@@ -214,13 +218,24 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       if (tri.side(mesh, state, p) != 0 || tri.side(mesh, state, q) != 0 ||
           tri.side(mesh, state, r) != 0)
         continue;
-      const int here = tri.side(mesh, state, tet[f]);
-      if (here == 0) continue;
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
-      if (tri.side(mesh, state, mesh.tets[other][other_face]) != -here) continue;
-      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0, options.inside_tolerance))
+      // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
+      // vertex that is itself on the cut says nothing.
+      const int here = tri.side(mesh, state, tet[f]);
+      const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
+      if (here != 0 && there != 0 && here == there) continue;
+      const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];
+      const Vec3 centroid = (xp + xq + xr) / 3.0;
+      if (!tri.contains(centroid, options.inside_tolerance)) continue;
+      // Nodes that came onto the cut in other sweeps of the stroke lie on it up to the snap
+      // rule: the face must lie along this triangle, near its plane and facing its way.
+      const Vec3 n = (xq - xp).cross(xr - xp);
+      const double longest = std::max({(xq - xp).norm(), (xr - xq).norm(), (xp - xr).norm()});
+      if (std::abs(tri.normal().dot(centroid - mesh.nodes[p]) + tri.distance(mesh, p)) >
+          0.25 * longest)
         continue;
+      if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) continue;
       if (!state.cuttable[other]) {  // the blade stops at the condensed part
         result.reached_interface = true;
         continue;
