@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/cutting/triangle_cut.hpp"
 
 #include "soft_tissue_cutting/cutting/edge_bisection.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -51,6 +52,48 @@ double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<S
   for (const Piece& p : pieces)
     smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
   return smallest;
+}
+
+double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto angles = dihedral_angles_deg(a, b, c, d);
+  return *std::min_element(angles.begin(), angles.end());
+}
+
+// Moves node v to `target` if v is an interior, unlocked node of the operation part that no
+// marked face touches, and its star keeps positive volume above the size guard and a smallest
+// dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
+bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
+                   const CutOptions& options, CutResult& result) {
+  if (state.locked[v]) return false;
+  const std::vector<int>& star = state.node_tets[v];
+  for (int t : star) {
+    if (!state.cuttable[t]) return false;
+    for (int f = 0; f < 4; ++f) {
+      if (mesh.tets[t][f] == v) continue;  // the face opposite v does not touch it
+      if (mesh.is_cut_face(t, f)) return false;               // on an earlier cut
+      if (neighbour_across(mesh, state, t, f).first < 0) return false;  // on the boundary
+    }
+  }
+  double before = 180, after = 180;
+  auto position = [&](int w, const Vec3& here) -> const Vec3& { return w == v ? here : mesh.nodes[w]; };
+  for (int t : star) {
+    const Tet& k = mesh.tets[t];
+    before = std::min(before, smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]],
+                                                mesh.nodes[k[2]], mesh.nodes[k[3]]));
+    const Vec3 &a = position(k[0], target), &b = position(k[1], target),
+               &c = position(k[2], target), &d = position(k[3], target);
+    if (!(signed_volume(a, b, c, d) > 2 * options.min_volume_fraction * state.origin_volume[t]))
+      return false;
+    after = std::min(after, smallest_dihedral(a, b, c, d));
+  }
+  if (after < std::min(before, options.relocate_min_dihedral_deg)) return false;
+  mesh.nodes[v] = target;
+  for (int t : star) {
+    state.grid.insert(mesh, t);  // its box may have grown
+    result.changed_tets.push_back(t);
+  }
+  result.moved_nodes.push_back(v);
+  return true;
 }
 
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
@@ -148,6 +191,17 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
           continue;
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
+        // Near an end: move that end onto the cut if it may move (relocate_node).
+        if (s < options.relocate || s > 1 - options.relocate) {
+          const int end = s < 0.5 ? u : v;
+          if (relocate_node(mesh, state, end, mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
+                            options, result)) {
+            tri.set_on(end);
+            set_on_stroke(state, end);
+            resnap = true;
+            continue;
+          }
+        }
         if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
           tri.set_on(s < 0.5 ? u : v);
           set_on_stroke(state, s < 0.5 ? u : v);

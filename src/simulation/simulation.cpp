@@ -5,6 +5,7 @@
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
+#include "soft_tissue_cutting/cutting/rest_mapping.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
@@ -19,21 +20,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-// The blade tip lies inside the (rest) tissue: in some tet near it.
-bool tip_inside_tissue(const TetMesh& mesh, const CutState& state, const Vec3& tip) {
-  for (int t : state.grid.query(mesh, tip, tip)) {
-    const Tet& k = mesh.tets[t];
-    const Vec3 &a = mesh.nodes[k[0]], &b = mesh.nodes[k[1]], &c = mesh.nodes[k[2]],
-               &d = mesh.nodes[k[3]];
-    const double v = signed_volume(a, b, c, d);
-    const double eps = -1e-12 * std::abs(v);
-    if (signed_volume(tip, b, c, d) >= eps && signed_volume(a, tip, c, d) >= eps &&
-        signed_volume(a, b, tip, d) >= eps && signed_volume(a, b, c, tip) >= eps)
-      return true;
-  }
-  return false;
 }
 
 }  // namespace
@@ -56,6 +42,10 @@ struct Simulation::Impl {
   std::optional<ContactAnchor> anchor;
   std::optional<BladePose> last_pose;
   std::vector<BladePose> stroke;  // poses of the current cutting stroke
+  // The last cut's end edge carried to rest coordinates, and the pose it was carried for: the
+  // next sweep of the same stroke starts from exactly this polyline (no gap, no overlap).
+  std::optional<BladePose> last_cut_pose;
+  std::vector<Vec3> last_rest_edge;
 
   bool cutting_enabled = true;
   std::uint64_t steps = 0, surface_version = 0;
@@ -99,6 +89,8 @@ struct Simulation::Impl {
     anchor.reset();
     last_pose.reset();
     stroke.clear();
+    last_cut_pose.reset();
+    last_rest_edge.clear();
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
@@ -136,12 +128,44 @@ struct Simulation::Impl {
     return r.converged;
   }
 
-  // Inserts the sweep between two blade poses; returns true if the mesh changed.
+  // Inserts the sweep between two blade poses; returns true if the mesh changed. The blade
+  // moves through the DEFORMED tissue: its edge is carried to rest coordinates through the
+  // current deformation (rest_mapping.hpp) before the rest mesh is cut there.
   bool cut(const BladePose& from, const BladePose& to, StepStats& s) {
     const double length = scene.scalpel.blade_length;
     auto t0 = Clock::now();
-    const CutResult r = cut_sweep(model->mesh_for_cutting(), cut_state, blade_edge(from, length),
-                                  blade_edge(to, length));
+    const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
+    DeformedToRest to_rest;
+    to_rest.build(model->mesh(), displacements(), model->partition().operation_tet);
+    constexpr int kSamples = 9;  // edge points carried; kept only where the map bends
+    std::vector<double> params(kSamples);
+    for (int i = 0; i < kSamples; ++i) params[i] = static_cast<double>(i) / (kSamples - 1);
+    const bool continues = last_cut_pose && last_cut_pose->position == from.position &&
+                           last_cut_pose->orientation.coeffs() == from.orientation.coeffs() &&
+                           last_rest_edge.size() == static_cast<size_t>(kSamples);
+    std::optional<std::vector<Vec3>> rest_from =
+        continues ? std::optional<std::vector<Vec3>>(last_rest_edge)
+                  : to_rest.map_edge(a.tip, a.heel, params);
+    std::optional<std::vector<Vec3>> rest_to = to_rest.map_edge(b.tip, b.heel, params);
+    // An edge wholly outside the tissue moves with the other edge's deformation.
+    auto shifted = [&](const std::vector<Vec3>& rest, const BladeEdge& e, const BladeEdge& other) {
+      std::vector<Vec3> out(rest.size());
+      for (size_t i = 0; i < rest.size(); ++i)
+        out[i] = rest[i] + (e.tip - other.tip) + params[i] * ((e.heel - e.tip) - (other.heel - other.tip));
+      return out;
+    };
+    if (!rest_from && rest_to) rest_from = shifted(*rest_to, a, b);
+    if (rest_from && !rest_to) rest_to = shifted(*rest_from, b, a);
+    last_cut_pose = to;
+    last_rest_edge = rest_to ? *rest_to : std::vector<Vec3>{};
+    if (!rest_from || !rest_to) {  // the edge is outside the operation part at both poses
+      s.cutting_ms += ms_since(t0);
+      return false;
+    }
+    const std::vector<int> keep = simplify_polylines(*rest_from, *rest_to, 0.25e-3);
+    std::vector<Vec3> band_from, band_to;
+    for (int k : keep) band_from.push_back((*rest_from)[k]), band_to.push_back((*rest_to)[k]);
+    const CutResult r = cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to);
     s.cutting_ms += ms_since(t0);
     s.reached_interface |= r.reached_interface;
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
@@ -211,7 +235,8 @@ struct Simulation::Impl {
         // The blade opens the tissue while its tip is in it; out of the tissue, it is free.
         if (last_pose) cut(*last_pose, *blade, s);
         stroke.push_back(*blade);
-        if (!tip_inside_tissue(model->mesh(), cut_state, tip)) {
+        surface_tree.refit(model->mesh(), displacements());
+        if (!surface_tree.contains(tip)) {  // the deformed tissue, where the blade is
           blade_state = BladeState::kFree;
           stroke.clear();
         }

@@ -32,7 +32,7 @@ Scene sagging_liver() {
   underside.box = Box{lo - Vec3::Constant(1), Vec3(hi.x() + 1, lo.y() + 0.15 * (hi.y() - lo.y()), hi.z() + 1)};
   s.fixed.push_back(underside);
   s.operation_region.kind = OperationRegion::Kind::kSphere;
-  s.operation_region.sphere = Sphere{top_node(s.mesh), 0.025};
+  s.operation_region.sphere = Sphere{top_node(s.mesh), 0.04};
   s.scalpel = ScalpelParams{0.02, 0.5};
   s.solver = SolverParams{"cpu", 1e-10, 4000};
   return s;
@@ -95,7 +95,11 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
        << " cm2, opened " << f.opened_area[0] * 1e4 << " / " << f.opened_area[1] * 1e4 << " cm2 ("
        << 100 * f.opening() << " %), Hausdorff " << f.hausdorff * 1e3 << " mm (faces->sweep "
        << f.faces_to_sweep * 1e3 << ", sweep->faces " << f.sweep_to_faces * 1e3 << "; "
-       << f.hausdorff_over_tolerance << " x tolerance), alignment " << f.wall_alignment;
+       << f.hausdorff_over_tolerance << " x tolerance; faces " << f.faces_over_tolerance
+       << " x), alignment " << f.wall_alignment << ", " << 100 * f.covered_area / std::max(f.swept_area, 1e-30)
+       << " % of the swept area within tolerance of an open face; worst hole "
+       << 1e3 * (f.worst_swept_point - top).dot(s.direction) << " mm along, "
+       << 1e3 * (f.worst_swept_point - top).dot(s.up) << " mm up from the rest top";
   std::printf("FIDELITY %s\n", line.str().c_str());
   EXPECT_GT(sag, 0.005) << line.str();
   InvariantLimits limits;

@@ -28,6 +28,14 @@ struct CutOptions {
   // lopsided keeps the cut as close to the blade as this allows: the cut surface lies at
   // most snap * (edge length) off the blade.
   double snap_tolerance = 0.1;
+  // Shape, not only size: an edge the cut crosses at t < relocate (or > 1 - relocate) has its
+  // nearer end MOVED onto the cut (rest position) instead of being split into a thin sliver,
+  // when that end is an interior node of the operation part (not on the boundary, not on an
+  // earlier cut, not locked) and no tet of its star gets worse than
+  // min(relocate_min_dihedral_deg, its current smallest dihedral angle). Moving an interior
+  // node keeps the total volume exactly (its star still tiles the same cavity).
+  double relocate = 0.3;
+  double relocate_min_dihedral_deg = 10.0;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
   // SPEC 6's "small fraction" is this number. With snap 0.1 a tet can be cut through twice
@@ -51,6 +59,9 @@ struct CutResult {
   // their index for the first child; the other children are appended.
   std::vector<int> changed_tets;
   std::vector<NewNode> new_nodes;
+  // Existing nodes whose rest position a cut moved onto the cut surface (their tets are in
+  // changed_tets: their element matrices change).
+  std::vector<int> moved_nodes;
   int tets_split = 0;        // parent tets bisected (a tet split twice counts twice)
   int nodes_added = 0;       // edge nodes + duplicates
   int cut_faces_added = 0;   // net new cut faces (each face once; a halved one counts 1 more)
