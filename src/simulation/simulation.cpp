@@ -156,9 +156,24 @@ struct Simulation::Impl {
     };
     if (!rest_from && rest_to) rest_from = shifted(*rest_to, a, b);
     if (rest_from && !rest_to) rest_to = shifted(*rest_from, b, a);
+    if (!rest_from && !rest_to) {
+      // Both ends outside (a sweep across the tissue, e.g. the ~cut service): carry both by
+      // the deformation where the edge is in the tissue on the way between them.
+      constexpr int kBetween = 16;
+      for (int k = 1; k < kBetween && !rest_to; ++k) {
+        const double f = static_cast<double>(k) / kBetween;
+        BladeEdge mid;
+        mid.tip = (1 - f) * a.tip + f * b.tip;
+        mid.heel = (1 - f) * a.heel + f * b.heel;
+        if (const auto rest_mid = to_rest.map_edge(mid.tip, mid.heel, params)) {
+          rest_from = shifted(*rest_mid, a, mid);
+          rest_to = shifted(*rest_mid, b, mid);
+        }
+      }
+    }
     last_cut_pose = to;
     last_rest_edge = rest_to ? *rest_to : std::vector<Vec3>{};
-    if (!rest_from || !rest_to) {  // the edge is outside the operation part at both poses
+    if (!rest_from || !rest_to) {  // the edge never meets the operation part
       s.cutting_ms += ms_since(t0);
       return false;
     }

@@ -11,6 +11,7 @@
 #include "soft_tissue_cutting/io/mesh_reader.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/partition/partition.hpp"
+#include "soft_tissue_cutting/scene/scene.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -129,6 +130,27 @@ inline std::vector<BladePose> stroke_poses(const Stroke& s, const std::vector<Ve
 inline void add_sweep(const BladeEdge& a, const BladeEdge& b, std::vector<SweptTriangle>& out) {
   out.push_back({{a.tip, a.heel, b.heel}, a.normal});
   out.push_back({{a.tip, b.heel, b.tip}, a.normal});
+}
+
+// The TetGen liver (sofa_liver2.obj, ~7k tets, 15 cm) on its fixed underside (lowest 15 %)
+// under gravity, E = 3 kPa: its top sags by centimetres. Operation sphere of 4 cm at the top.
+inline Scene sagging_liver() {
+  Scene s;
+  s.source = "tetgen liver2 (test)";
+  s.mesh = tetgen_liver("liver2", 5000);
+  s.material = Material{3000.0, 0.45, 1000.0};
+  s.gravity = Vec3(0, -9.81, 0);
+  Vec3 lo = s.mesh.nodes[0], hi = lo;
+  for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  NodeSelector underside;
+  underside.kind = NodeSelector::Kind::kBox;
+  underside.box = Box{lo - Vec3::Constant(1), Vec3(hi.x() + 1, lo.y() + 0.15 * (hi.y() - lo.y()), hi.z() + 1)};
+  s.fixed.push_back(underside);
+  s.operation_region.kind = OperationRegion::Kind::kSphere;
+  s.operation_region.sphere = Sphere{top_node(s.mesh), 0.04};
+  s.scalpel = ScalpelParams{0.02, 0.5};
+  s.solver = SolverParams{"cpu", 1e-10, 4000};
+  return s;
 }
 
 }  // namespace stc::fidelity

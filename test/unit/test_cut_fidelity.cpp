@@ -131,7 +131,9 @@ Stroke variant(Stroke s, double tilt, double step, bool curved) {
   return s;
 }
 
-// The matrix of issue 9 item 1 on one mesh; each stroke on a fresh copy.
+// The matrix of issue 9 item 1 on one mesh; each stroke on a fresh copy. Asserted here: SPEC 6
+// and floors well under what every configuration measures (a regression guard); the issue's
+// own targets are asserted where they are met (IssueTargets below) - README lists the rest.
 void measure_matrix(const std::string& mesh_name) {
   for (bool curved : {false, true})
     for (double tilt : {0.0, 45.0})
@@ -144,6 +146,10 @@ void measure_matrix(const std::string& mesh_name) {
         const Figures fig = run_stroke(*b, variant(b->stroke, tilt, step, curved), label.str());
         EXPECT_TRUE(fig.violated.empty()) << fig.line << ": " << fig.violated.front();
         EXPECT_GT(fig.f.swept_area, 1e-4) << fig.line;  // the stroke is in the tissue
+        EXPECT_GE(fig.f.covered_area, 0.25 * fig.f.swept_area) << fig.line;
+        EXPECT_GE(fig.f.opening(), 0.1) << fig.line;
+        EXPECT_LE(fig.f.faces_over_tolerance, 2.0) << fig.line;
+        EXPECT_GE(fig.f.wall_alignment, 0.7) << fig.line;
       }
 }
 
@@ -152,6 +158,34 @@ TEST(CutFidelity, Liver2Coarse) { measure_matrix("liver2-5000"); }
 TEST(CutFidelity, LiverBoundaryCoarse) { measure_matrix("liver-5000"); }
 TEST(CutFidelity, Liver2Fine) { measure_matrix("liver2-50000"); }
 TEST(CutFidelity, LiverBoundaryFine) { measure_matrix("liver-50000"); }
+
+// Issue 9 items 1 and 2 as stated, on the coarse TetGen liver (sofa_liver2.obj), for the
+// strokes that meet them: each side opens >= 90 % of the swept area, every swept point lies
+// within max(0.5 mm, 0.25 h) of an open face and every open face within that of the sweep,
+// the walls face along the blade normal, and no step through tissue leaves it untouched
+// (3 mm steps).
+TEST(CutFidelity, IssueTargetsOnTheCoarseLiver) {
+  struct Case {
+    double tilt, step;
+    bool curved;
+  };
+  for (const Case& c : {Case{0, 3e-3, false}, Case{0, 0.2e-3, false}, Case{45, 3e-3, false},
+                        Case{0, 3e-3, true}}) {
+    auto b = make_bench("liver2-5000");
+    std::ostringstream label;
+    label << "target " << (c.curved ? "curved" : "straight") << " tilt " << c.tilt << " step "
+          << c.step * 1e3 << " mm";
+    const Figures fig = run_stroke(*b, variant(b->stroke, c.tilt, c.step, c.curved), label.str());
+    EXPECT_TRUE(fig.violated.empty()) << fig.line;
+    EXPECT_GE(std::min(fig.f.opened_area[0], fig.f.opened_area[1]), 0.9 * fig.f.swept_area) << fig.line;
+    EXPECT_GE(fig.f.covered_area, 0.99 * fig.f.swept_area) << fig.line;
+    EXPECT_LE(fig.f.hausdorff_over_tolerance, 1.0) << fig.line;
+    EXPECT_GE(fig.f.wall_alignment, 0.95) << fig.line;
+    if (c.step > 1e-3) {
+      EXPECT_LE(fig.changed_nothing, 2) << fig.line;
+    }
+  }
+}
 
 }  // namespace
 }  // namespace stc

@@ -6,6 +6,7 @@
 // is inside.
 #include "cut_fidelity_scenes.hpp"
 
+#include "soft_tissue_cutting/cutting/cut_measures.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
@@ -18,25 +19,6 @@ namespace stc {
 namespace {
 
 using namespace fidelity;
-
-Scene sagging_liver() {
-  Scene s;
-  s.source = "tetgen liver2 (test)";
-  s.mesh = tetgen_liver("liver2", 5000);
-  s.material = Material{3000.0, 0.45, 1000.0};
-  s.gravity = Vec3(0, -9.81, 0);
-  Vec3 lo = s.mesh.nodes[0], hi = lo;
-  for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  NodeSelector underside;
-  underside.kind = NodeSelector::Kind::kBox;
-  underside.box = Box{lo - Vec3::Constant(1), Vec3(hi.x() + 1, lo.y() + 0.15 * (hi.y() - lo.y()), hi.z() + 1)};
-  s.fixed.push_back(underside);
-  s.operation_region.kind = OperationRegion::Kind::kSphere;
-  s.operation_region.sphere = Sphere{top_node(s.mesh), 0.04};
-  s.scalpel = ScalpelParams{0.02, 0.5};
-  s.solver = SolverParams{"cpu", 1e-10, 4000};
-  return s;
-}
 
 BoundarySurface surface_of(const DeformedSurface& d) {
   BoundarySurface s;
@@ -91,7 +73,8 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   const CutFidelity f = measure_cut_fidelity(region, carried, sweep, 0.25e-3);
   std::ostringstream line;
   line.precision(3);
-  line << "sagging liver (sag " << sag * 1e3 << " mm): " << out.message << "; swept " << f.swept_area * 1e4
+  line << "sagging liver (sag " << sag * 1e3 << " mm): " << out.message << " (" << out.tets_split
+       << " tets split, " << closed_cut_faces(sim.mesh()) << " cut faces still closed)" << "; swept " << f.swept_area * 1e4
        << " cm2, opened " << f.opened_area[0] * 1e4 << " / " << f.opened_area[1] * 1e4 << " cm2 ("
        << 100 * f.opening() << " %), Hausdorff " << f.hausdorff * 1e3 << " mm (faces->sweep "
        << f.faces_to_sweep * 1e3 << ", sweep->faces " << f.sweep_to_faces * 1e3 << "; "
@@ -101,12 +84,36 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
        << 1e3 * (f.worst_swept_point - top).dot(s.direction) << " mm along, "
        << 1e3 * (f.worst_swept_point - top).dot(s.up) << " mm up from the rest top";
   std::printf("FIDELITY %s\n", line.str().c_str());
+  // STC_MAP=1: a map of the swept surface (rows: mm above the tip path's surface level;
+  // columns: mm along) - '#' within 1 mm of an open face, '+' within 3 mm, '.' farther.
+  if (std::getenv("STC_MAP")) {
+    std::vector<std::array<Vec3, 3>> open_faces;
+    for (const BoundaryTriangle& t : extract_boundary_surface(carried).triangles)
+      if (t.cut) open_faces.push_back({carried.nodes[t.nodes[0]], carried.nodes[t.nodes[1]], carried.nodes[t.nodes[2]]});
+    for (double up = 0.006; up >= -0.012; up -= 0.001) {
+      std::string row;
+      for (double along = -0.016; along <= 0.016; along += 0.001) {
+        const Vec3 tip0 = poses.front().position, tip1 = poses.back().position;
+        const double a = (along + 0.015) / 0.03;
+        const Vec3 p = tip0 + a * (tip1 - tip0) + (up + 0.0) * Vec3::UnitY() + Vec3::UnitY() * 0.008;
+        double best = 1;
+        for (const auto& f : open_faces) best = std::min(best, point_triangle_distance(p, f[0], f[1], f[2]));
+        row += !region.contains(p) ? ' ' : best < 1e-3 ? '#' : best < 3e-3 ? '+' : '.';
+      }
+      std::printf("%6.1f |%s|\n", up * 1e3, row.c_str());
+    }
+  }
   EXPECT_GT(sag, 0.005) << line.str();
   InvariantLimits limits;
   limits.initial_volume = sim.counts().volume_initial;
   const auto violated = check_cut_invariants(sim.mesh(), sim.tet_size_classes(), limits);
   EXPECT_TRUE(violated.empty()) << violated.front();
-  EXPECT_LE(f.faces_to_sweep, 3e-3) << line.str();
+  // Item 3: the walls, carried by the deformation the blade cut through, lie on its path
+  // (before the blade was carried to rest coordinates they lay 25 mm off it, where the rest
+  // mesh was). Opened: a floor only; the swept area is not all open yet (README).
+  EXPECT_LE(f.faces_over_tolerance, 1.0) << line.str();
+  EXPECT_GE(f.wall_alignment, 0.95) << line.str();
+  EXPECT_GE(f.covered_area, 0.5 * f.swept_area) << line.str();
 }
 
 TEST(CutFidelityGravity, ContactAsSoonAsTheTipIsInsideTheSaggedSurface) {

@@ -2,9 +2,12 @@
 // Simulation::cut_along (cut insertion + re-assembly + free pieces held + solve). After every
 // sweep: the geometric invariants, a symmetric hybrid matrix that is positive definite on the
 // free DOF (held pieces excluded: they are constrained), a converged finite solution.
+#include "cut_fidelity_scenes.hpp"
+
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
@@ -69,6 +72,47 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
   std::printf("random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n", cuts,
               kSweeps, sim.counts().tets_split, sim.counts().tets, sim.counts().free_pieces_held);
   EXPECT_GT(cuts, kSweeps / 3);
+}
+
+// The same on a TetGen liver sagging under gravity (issue 9): 100 random strokes through its
+// operation part, each stroke carried to rest coordinates through the sag. After every
+// stroke: SPEC 6, an SPD system on the free DOF, a converged finite solution. The smallest
+// dihedral angle and the CG iterations of the solve after each stroke are reported (issue 9
+// item 4 asks for >= 5 deg and <= 2x the uncut mesh's iterations; see README, not yet met).
+TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
+  const Scene scene = fidelity::sagging_liver();
+  Simulation sim(scene);
+  const double dihedral_before = mesh_quality(sim.mesh()).min_dihedral_deg;
+  const int cold_iterations = sim.last_stats().cg_iterations;
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const Vec3 centre = scene.operation_region.sphere.center;
+  int cuts = 0;
+  std::vector<int> iterations;
+  for (int k = 0; k < 100; ++k) {
+    BladePose a, b;
+    a.position = centre + 0.02 * Vec3(unit(rng), unit(rng) - 0.5, unit(rng));
+    b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
+    a.orientation = Eigen::Quaterniond(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+    b.orientation = a.orientation;
+    const CutOutcome out = sim.cut_along({a, b});
+    cuts += out.success;
+    iterations.push_back(sim.model().last_result().iterations);
+    InvariantLimits limits;
+    limits.initial_volume = sim.counts().volume_initial;
+    const auto violated = check_cut_invariants(sim.mesh(), sim.tet_size_classes(), limits);
+    ASSERT_TRUE(violated.empty()) << "stroke " << k << ": " << violated.front();
+    EXPECT_NO_THROW(SparseCholesky{free_block(sim)}) << "stroke " << k << ": not SPD";
+    ASSERT_TRUE(sim.model().last_result().converged) << "stroke " << k;
+    ASSERT_TRUE(sim.model().displacement().allFinite()) << "stroke " << k;
+  }
+  std::sort(iterations.begin(), iterations.end());
+  const double dihedral_after = mesh_quality(sim.mesh()).min_dihedral_deg;
+  std::printf("TetGen liver, 100 random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
+              "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d)\n",
+              cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before, dihedral_after,
+              iterations[iterations.size() / 2], iterations.back(), cold_iterations);
+  EXPECT_GT(cuts, 30);
 }
 
 }  // namespace
