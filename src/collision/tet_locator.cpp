@@ -38,8 +38,8 @@ std::optional<TetLocation> TetLocator::locate(const Vec3& p, double tolerance) c
   double best_min = -tolerance;
   for (int k : candidates) {
     const Tet& t = mesh_->tets[static_cast<size_t>(tets_[static_cast<size_t>(k)])];
-    const auto w = barycentric(positions_[t[0]], positions_[t[1]], positions_[t[2]],
-                               positions_[t[3]], p);
+    const auto w =
+        barycentric(positions_[t[0]], positions_[t[1]], positions_[t[2]], positions_[t[3]], p);
     const double smallest = std::min({w[0], w[1], w[2], w[3]});
     if (smallest >= best_min) {
       best_min = smallest;

@@ -17,7 +17,8 @@ double tolerance_at(double local_edge) { return std::max(0.5e-3, 0.25 * local_ed
 // standing for area / n^2.
 void sample_triangle(const std::array<Vec3, 3>& x, double h, std::vector<Vec3>& points,
                      double& weight) {
-  const double longest = std::max({(x[1] - x[0]).norm(), (x[2] - x[1]).norm(), (x[0] - x[2]).norm()});
+  const double longest =
+      std::max({(x[1] - x[0]).norm(), (x[2] - x[1]).norm(), (x[0] - x[2]).norm()});
   const int n = std::clamp(static_cast<int>(std::ceil(longest / h)), 1, 400);
   weight = 0.5 * (x[1] - x[0]).cross(x[2] - x[0]).norm() / (n * n);
   points.clear();
@@ -26,7 +27,8 @@ void sample_triangle(const std::array<Vec3, 3>& x, double h, std::vector<Vec3>& 
       // upward sub-triangle (i, j), (i+1, j), (i, j+1)
       points.push_back(x[0] + ((i + 1.0 / 3) * (x[1] - x[0]) + (j + 1.0 / 3) * (x[2] - x[0])) / n);
       if (i + j + 1 < n)  // downward one (i+1, j), (i, j+1), (i+1, j+1)
-        points.push_back(x[0] + ((i + 2.0 / 3) * (x[1] - x[0]) + (j + 2.0 / 3) * (x[2] - x[0])) / n);
+        points.push_back(x[0] +
+                         ((i + 2.0 / 3) * (x[1] - x[0]) + (j + 2.0 / 3) * (x[2] - x[0])) / n);
     }
 }
 
@@ -87,7 +89,8 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
   std::vector<Face> faces;
   for (const BoundaryTriangle& t : extract_boundary_surface(mesh).triangles) {
     if (!t.cut) continue;
-    Face f{{mesh.nodes[t.nodes[0]], mesh.nodes[t.nodes[1]], mesh.nodes[t.nodes[2]]}, Vec3::Zero(), 0};
+    Face f{
+        {mesh.nodes[t.nodes[0]], mesh.nodes[t.nodes[1]], mesh.nodes[t.nodes[2]]}, Vec3::Zero(), 0};
     const Vec3 n = (f.x[1] - f.x[0]).cross(f.x[2] - f.x[0]);
     f.area = 0.5 * n.norm();
     if (!(f.area > 0)) continue;
@@ -117,8 +120,12 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
     if (!region.contains(centroid, &h)) continue;
     ++out.open_cut_faces;
     int which = -1;
-    const std::array<Vec3, 7> points = {f.x[0], f.x[1], f.x[2], centroid,
-                                        0.5 * (f.x[0] + f.x[1]), 0.5 * (f.x[1] + f.x[2]),
+    const std::array<Vec3, 7> points = {f.x[0],
+                                        f.x[1],
+                                        f.x[2],
+                                        centroid,
+                                        0.5 * (f.x[0] + f.x[1]),
+                                        0.5 * (f.x[1] + f.x[2]),
                                         0.5 * (f.x[2] + f.x[0])};
     for (const Vec3& p : points) {
       int k = -1;

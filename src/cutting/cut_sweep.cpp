@@ -88,7 +88,8 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
 CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from,
                    const std::vector<Vec3>& to, const CutOptions& options) {
   if (from.size() < 2 || from.size() != to.size()) return {};
-  const double scale = std::max((from.back() - from.front()).norm(), (to.front() - from.front()).norm());
+  const double scale =
+      std::max((from.back() - from.front()).norm(), (to.front() - from.front()).norm());
   const bool continues = (from.front() - state.last_sweep_end[0]).norm() <= 1e-9 * scale &&
                          (from.back() - state.last_sweep_end[1]).norm() <= 1e-9 * scale;
   // The margin beyond the blade's fronts (CutOptions::front_margin).
@@ -103,7 +104,8 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
       if (!state.cuttable[t]) continue;
       const Tet& k = mesh.tets[t];
       for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) sum += (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm(), ++count;
+        for (int j = i + 1; j < 4; ++j)
+          sum += (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm(), ++count;
     }
     margin = count ? options.front_margin_fraction * sum / count : 0;
   }
@@ -130,7 +132,8 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     sweep.push_back({a[i], b[i + 1], b[i]});
   }
   const std::vector<std::array<Vec3, 3>> none;
-  CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
+  CutResult result =
+      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
   // The stroke so far: every non-degenerate sweep triangle since the blade began this
   // continuous cut, so that faces spanning many small sweeps (a blade moving 1 mm per step
   // through 6 mm tets) are still opened. Bounded so a very long stroke stays cheap.

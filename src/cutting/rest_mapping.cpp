@@ -49,7 +49,8 @@ std::optional<std::vector<Vec3>> DeformedToRest::map_edge(const Vec3& tip, const
       if (tet[j] >= 0 && (nearest == n || std::abs(s[j] - s[i]) < std::abs(s[nearest] - s[i])))
         nearest = j;
     const Tet& k = mesh_->tets[tet[nearest]];
-    const auto w = barycentric(deformed[k[0]], deformed[k[1]], deformed[k[2]], deformed[k[3]], x[i]);
+    const auto w =
+        barycentric(deformed[k[0]], deformed[k[1]], deformed[k[2]], deformed[k[3]], x[i]);
     out[i] = rest_point(*mesh_, tet[nearest], w);
   }
   return out;

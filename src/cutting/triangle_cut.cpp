@@ -69,13 +69,15 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
   for (int t : star) {
     if (!state.cuttable[t]) return false;
     for (int f = 0; f < 4; ++f) {
-      if (mesh.tets[t][f] == v) continue;  // the face opposite v does not touch it
-      if (mesh.is_cut_face(t, f)) return false;               // on an earlier cut
+      if (mesh.tets[t][f] == v) continue;        // the face opposite v does not touch it
+      if (mesh.is_cut_face(t, f)) return false;  // on an earlier cut
       if (neighbour_across(mesh, state, t, f).first < 0) return false;  // on the boundary
     }
   }
   double before = 180, after = 180;
-  auto position = [&](int w, const Vec3& here) -> const Vec3& { return w == v ? here : mesh.nodes[w]; };
+  auto position = [&](int w, const Vec3& here) -> const Vec3& {
+    return w == v ? here : mesh.nodes[w];
+  };
   for (int t : star) {
     const Tet& k = mesh.tets[t];
     before = std::min(before, smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]],
@@ -145,7 +147,8 @@ void TriangleClassification::bounds(Vec3& lo, Vec3& hi) const {
   hi = a_.cwiseMax(b_).cwiseMax(c_) + pad;
 }
 
-std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet, int face) {
+std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state, int tet,
+                                     int face) {
   const Tet& t = mesh.tets[tet];
   const int p = t[kTetFaces[face][0]], q = t[kTetFaces[face][1]], r = t[kTetFaces[face][2]];
   for (int other : state.node_tets[p]) {
@@ -187,7 +190,8 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         if (state.locked[u] && state.locked[v]) continue;  // interface edges stay whole
         const double du = tri.distance(mesh, u), dv = tri.distance(mesh, v);
         const double s = du / (du - dv);
-        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]), options.inside_tolerance))
+        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
+                          options.inside_tolerance))
           continue;
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].

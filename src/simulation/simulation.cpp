@@ -151,7 +151,8 @@ struct Simulation::Impl {
     auto shifted = [&](const std::vector<Vec3>& rest, const BladeEdge& e, const BladeEdge& other) {
       std::vector<Vec3> out(rest.size());
       for (size_t i = 0; i < rest.size(); ++i)
-        out[i] = rest[i] + (e.tip - other.tip) + params[i] * ((e.heel - e.tip) - (other.heel - other.tip));
+        out[i] = rest[i] + (e.tip - other.tip) +
+                 params[i] * ((e.heel - e.tip) - (other.heel - other.tip));
       return out;
     };
     if (!rest_from && rest_to) rest_from = shifted(*rest_to, a, b);

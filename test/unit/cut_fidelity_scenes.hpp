@@ -13,12 +13,12 @@
 #include "soft_tissue_cutting/partition/partition.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 namespace stc::fidelity {
@@ -76,7 +76,8 @@ inline std::optional<Vec3> surface_above(const std::vector<Vec3>& x, const Bound
   double best = 2;
   for (const BoundaryTriangle& t : surface.triangles) {
     double s = 0;
-    if (segment_crosses_triangle(from, to, x[t.nodes[0]], x[t.nodes[1]], x[t.nodes[2]], s) && s < best)
+    if (segment_crosses_triangle(from, to, x[t.nodes[0]], x[t.nodes[1]], x[t.nodes[2]], s) &&
+        s < best)
       best = s;
   }
   if (best > 1) return std::nullopt;
@@ -84,9 +85,9 @@ inline std::optional<Vec3> surface_above(const std::vector<Vec3>& x, const Bound
 }
 
 struct Stroke {
-  Vec3 centre;          // middle of the path, on the surface's horizontal
-  Vec3 up;              // out of the tissue: a vertical blade's edge points this way
-  Vec3 direction;       // of travel at the centre, perpendicular to up
+  Vec3 centre;     // middle of the path, on the surface's horizontal
+  Vec3 up;         // out of the tissue: a vertical blade's edge points this way
+  Vec3 direction;  // of travel at the centre, perpendicular to up
   double length = 0.03;
   double depth = 0.01;  // tip below the surface along -up
   double tilt_deg = 0;  // edge tilted from up towards the blade normal
@@ -144,7 +145,8 @@ inline Scene sagging_liver() {
   for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
   NodeSelector underside;
   underside.kind = NodeSelector::Kind::kBox;
-  underside.box = Box{lo - Vec3::Constant(1), Vec3(hi.x() + 1, lo.y() + 0.15 * (hi.y() - lo.y()), hi.z() + 1)};
+  underside.box =
+      Box{lo - Vec3::Constant(1), Vec3(hi.x() + 1, lo.y() + 0.15 * (hi.y() - lo.y()), hi.z() + 1)};
   s.fixed.push_back(underside);
   s.operation_region.kind = OperationRegion::Kind::kSphere;
   s.operation_region.sphere = Sphere{top_node(s.mesh), 0.04};

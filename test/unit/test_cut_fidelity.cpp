@@ -78,10 +78,12 @@ constexpr double kBladeLength = 0.02;
 Figures run_stroke(Bench& b, const Stroke& s, const std::string& label) {
   Figures out;
   out.min_dihedral_before = mesh_quality(b.mesh).min_dihedral_deg;
-  const std::vector<BladePose> poses = stroke_poses(s, b.mesh.nodes, extract_boundary_surface(b.mesh));
+  const std::vector<BladePose> poses =
+      stroke_poses(s, b.mesh.nodes, extract_boundary_surface(b.mesh));
   std::vector<SweptTriangle> sweep;
   for (size_t i = 1; i < poses.size(); ++i) {
-    const BladeEdge from = blade_edge(poses[i - 1], kBladeLength), to = blade_edge(poses[i], kBladeLength);
+    const BladeEdge from = blade_edge(poses[i - 1], kBladeLength),
+                    to = blade_edge(poses[i], kBladeLength);
     const CutResult r = cut_sweep(b.mesh, b.state, from, to);
     const size_t first = sweep.size();
     add_sweep(from, to, sweep);
@@ -94,7 +96,8 @@ Figures run_stroke(Bench& b, const Stroke& s, const std::string& label) {
           tissue = b.region->contains(sweep[k].x[0] + u * (sweep[k].x[1] - sweep[k].x[0]) +
                                       v * (sweep[k].x[2] - sweep[k].x[0]));
     out.through_tissue += tissue;
-    if (tissue && r.tets_split == 0 && r.new_nodes.empty() && r.cut_faces_added == 0) ++out.changed_nothing;
+    if (tissue && r.tets_split == 0 && r.new_nodes.empty() && r.cut_faces_added == 0)
+      ++out.changed_nothing;
   }
   out.f = measure_cut_fidelity(*b.region, b.mesh, sweep, 0.25e-3);
   out.min_dihedral = mesh_quality(b.mesh).min_dihedral_deg;
@@ -105,19 +108,21 @@ Figures run_stroke(Bench& b, const Stroke& s, const std::string& label) {
   line.precision(3);
   line << b.name << " " << label << ": swept " << out.f.swept_area * 1e4 << " cm2, opened "
        << out.f.opened_area[0] * 1e4 << " / " << out.f.opened_area[1] * 1e4 << " cm2 ("
-       << 100 * out.f.opening() << " % the lesser side; " << 100 * out.f.covered_area / out.f.swept_area
-       << " % of the swept area within tolerance of an open face), Hausdorff " << out.f.hausdorff * 1e3
-       << " mm (faces->sweep " << out.f.faces_to_sweep * 1e3 << ", sweep->faces "
-       << out.f.sweep_to_faces * 1e3 << "; " << out.f.hausdorff_over_tolerance
-       << " x tolerance; faces " << out.f.faces_over_tolerance << " x), wall alignment " << out.f.wall_alignment << ", min dihedral "
-       << out.min_dihedral_before << " -> " << out.min_dihedral << " deg, " << out.changed_nothing
-       << " of " << out.through_tissue << " steps through tissue changed nothing, tets "
-       << b.mesh.num_tets() << ", closed cut faces " << closed_cut_faces(b.mesh);
+       << 100 * out.f.opening() << " % the lesser side; "
+       << 100 * out.f.covered_area / out.f.swept_area
+       << " % of the swept area within tolerance of an open face), Hausdorff "
+       << out.f.hausdorff * 1e3 << " mm (faces->sweep " << out.f.faces_to_sweep * 1e3
+       << ", sweep->faces " << out.f.sweep_to_faces * 1e3 << "; " << out.f.hausdorff_over_tolerance
+       << " x tolerance; faces " << out.f.faces_over_tolerance << " x), wall alignment "
+       << out.f.wall_alignment << ", min dihedral " << out.min_dihedral_before << " -> "
+       << out.min_dihedral << " deg, " << out.changed_nothing << " of " << out.through_tissue
+       << " steps through tissue changed nothing, tets " << b.mesh.num_tets()
+       << ", closed cut faces " << closed_cut_faces(b.mesh);
   {
     // Where the largest hole is: along the path, under the surface.
     const Vec3 w = out.f.worst_swept_point - s.centre;
-    line << ", worst hole at " << 1e3 * w.dot(s.direction) << " mm along, "
-         << 1e3 * w.dot(s.up) << " mm up from the centre";
+    line << ", worst hole at " << 1e3 * w.dot(s.direction) << " mm along, " << 1e3 * w.dot(s.up)
+         << " mm up from the centre";
   }
   out.line = line.str();
   std::printf("FIDELITY %s\n", out.line.c_str());
@@ -139,7 +144,8 @@ void measure_matrix(const std::string& mesh_name) {
     for (double tilt : {0.0, 45.0})
       for (double step : {0.2e-3, 3e-3}) {
         std::ostringstream label;
-        label << (curved ? "curved" : "straight") << " tilt " << tilt << " step " << step * 1e3 << " mm";
+        label << (curved ? "curved" : "straight") << " tilt " << tilt << " step " << step * 1e3
+              << " mm";
         if (const char* only = std::getenv("STC_FIDELITY_ONLY"))
           if (label.str().find(only) == std::string::npos) continue;
         auto b = make_bench(mesh_name);
@@ -169,15 +175,16 @@ TEST(CutFidelity, IssueTargetsOnTheCoarseLiver) {
     double tilt, step;
     bool curved;
   };
-  for (const Case& c : {Case{0, 3e-3, false}, Case{0, 0.2e-3, false}, Case{45, 3e-3, false},
-                        Case{0, 3e-3, true}}) {
+  for (const Case& c :
+       {Case{0, 3e-3, false}, Case{0, 0.2e-3, false}, Case{45, 3e-3, false}, Case{0, 3e-3, true}}) {
     auto b = make_bench("liver2-5000");
     std::ostringstream label;
     label << "target " << (c.curved ? "curved" : "straight") << " tilt " << c.tilt << " step "
           << c.step * 1e3 << " mm";
     const Figures fig = run_stroke(*b, variant(b->stroke, c.tilt, c.step, c.curved), label.str());
     EXPECT_TRUE(fig.violated.empty()) << fig.line;
-    EXPECT_GE(std::min(fig.f.opened_area[0], fig.f.opened_area[1]), 0.9 * fig.f.swept_area) << fig.line;
+    EXPECT_GE(std::min(fig.f.opened_area[0], fig.f.opened_area[1]), 0.9 * fig.f.swept_area)
+        << fig.line;
     EXPECT_GE(fig.f.covered_area, 0.99 * fig.f.swept_area) << fig.line;
     EXPECT_LE(fig.f.hausdorff_over_tolerance, 1.0) << fig.line;
     EXPECT_GE(fig.f.wall_alignment, 0.95) << fig.line;

@@ -35,7 +35,8 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   double sag = 0;
   for (int i = 0; i < uncut.num_nodes(); ++i) sag = std::max(sag, -u_pre[3 * i + 1]);
   std::vector<Vec3> deformed(uncut.nodes.size());
-  for (size_t i = 0; i < deformed.size(); ++i) deformed[i] = uncut.nodes[i] + u_pre.segment<3>(3 * i);
+  for (size_t i = 0; i < deformed.size(); ++i)
+    deformed[i] = uncut.nodes[i] + u_pre.segment<3>(3 * i);
   const Partition& p = sim.model().partition();
   std::vector<std::uint8_t> interface(uncut.nodes.size(), 0);
   for (int i : p.interface) interface[static_cast<size_t>(i)] = 1;
@@ -64,7 +65,8 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
     const auto hit = rest.locate(x, 1e-6);
     ASSERT_TRUE(hit.has_value());
     Vec3 u = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) u += hit->barycentric[k] * u_pre.segment<3>(3 * uncut.tets[hit->tet][k]);
+    for (int k = 0; k < 4; ++k)
+      u += hit->barycentric[k] * u_pre.segment<3>(3 * uncut.tets[hit->tet][k]);
     x += u;
   }
   TetMesh uncut_deformed = uncut;
@@ -74,12 +76,13 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   std::ostringstream line;
   line.precision(3);
   line << "sagging liver (sag " << sag * 1e3 << " mm): " << out.message << " (" << out.tets_split
-       << " tets split, " << closed_cut_faces(sim.mesh()) << " cut faces still closed)" << "; swept " << f.swept_area * 1e4
-       << " cm2, opened " << f.opened_area[0] * 1e4 << " / " << f.opened_area[1] * 1e4 << " cm2 ("
-       << 100 * f.opening() << " %), Hausdorff " << f.hausdorff * 1e3 << " mm (faces->sweep "
-       << f.faces_to_sweep * 1e3 << ", sweep->faces " << f.sweep_to_faces * 1e3 << "; "
-       << f.hausdorff_over_tolerance << " x tolerance; faces " << f.faces_over_tolerance
-       << " x), alignment " << f.wall_alignment << ", " << 100 * f.covered_area / std::max(f.swept_area, 1e-30)
+       << " tets split, " << closed_cut_faces(sim.mesh()) << " cut faces still closed)"
+       << "; swept " << f.swept_area * 1e4 << " cm2, opened " << f.opened_area[0] * 1e4 << " / "
+       << f.opened_area[1] * 1e4 << " cm2 (" << 100 * f.opening() << " %), Hausdorff "
+       << f.hausdorff * 1e3 << " mm (faces->sweep " << f.faces_to_sweep * 1e3 << ", sweep->faces "
+       << f.sweep_to_faces * 1e3 << "; " << f.hausdorff_over_tolerance << " x tolerance; faces "
+       << f.faces_over_tolerance << " x), alignment " << f.wall_alignment << ", "
+       << 100 * f.covered_area / std::max(f.swept_area, 1e-30)
        << " % of the swept area within tolerance of an open face; worst hole "
        << 1e3 * (f.worst_swept_point - top).dot(s.direction) << " mm along, "
        << 1e3 * (f.worst_swept_point - top).dot(s.up) << " mm up from the rest top";
@@ -89,15 +92,19 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   if (std::getenv("STC_MAP")) {
     std::vector<std::array<Vec3, 3>> open_faces;
     for (const BoundaryTriangle& t : extract_boundary_surface(carried).triangles)
-      if (t.cut) open_faces.push_back({carried.nodes[t.nodes[0]], carried.nodes[t.nodes[1]], carried.nodes[t.nodes[2]]});
+      if (t.cut)
+        open_faces.push_back(
+            {carried.nodes[t.nodes[0]], carried.nodes[t.nodes[1]], carried.nodes[t.nodes[2]]});
     for (double up = 0.006; up >= -0.012; up -= 0.001) {
       std::string row;
       for (double along = -0.016; along <= 0.016; along += 0.001) {
         const Vec3 tip0 = poses.front().position, tip1 = poses.back().position;
         const double a = (along + 0.015) / 0.03;
-        const Vec3 p = tip0 + a * (tip1 - tip0) + (up + 0.0) * Vec3::UnitY() + Vec3::UnitY() * 0.008;
+        const Vec3 p =
+            tip0 + a * (tip1 - tip0) + (up + 0.0) * Vec3::UnitY() + Vec3::UnitY() * 0.008;
         double best = 1;
-        for (const auto& f : open_faces) best = std::min(best, point_triangle_distance(p, f[0], f[1], f[2]));
+        for (const auto& f : open_faces)
+          best = std::min(best, point_triangle_distance(p, f[0], f[1], f[2]));
         row += !region.contains(p) ? ' ' : best < 1e-3 ? '#' : best < 3e-3 ? '+' : '.';
       }
       std::printf("%6.1f |%s|\n", up * 1e3, row.c_str());
@@ -134,8 +141,9 @@ TEST(CutFidelityGravity, ContactAsSoonAsTheTipIsInsideTheSaggedSurface) {
       break;
     }
   }
-  std::printf("FIDELITY sagging liver press: contact at tip depth %.2f mm under the deformed surface\n",
-              contact_depth * 1e3);
+  std::printf(
+      "FIDELITY sagging liver press: contact at tip depth %.2f mm under the deformed surface\n",
+      contact_depth * 1e3);
   EXPECT_LE(contact_depth, 0.5e-3) << "contact at depth " << contact_depth * 1e3 << " mm";
 }
 

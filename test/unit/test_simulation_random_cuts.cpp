@@ -54,7 +54,8 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
     BladePose a, b;
     a.position = centre + 0.02 * Vec3(unit(rng) - 0.5, unit(rng), unit(rng));
     b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
-    a.orientation = Eigen::Quaterniond(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+    a.orientation = Eigen::Quaterniond(
+        Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
     b.orientation = a.orientation;
     const CutOutcome out = sim.cut_along({a, b});
     cuts += out.success;
@@ -93,7 +94,8 @@ TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
     BladePose a, b;
     a.position = centre + 0.02 * Vec3(unit(rng), unit(rng) - 0.5, unit(rng));
     b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
-    a.orientation = Eigen::Quaterniond(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+    a.orientation = Eigen::Quaterniond(
+        Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
     b.orientation = a.orientation;
     const CutOutcome out = sim.cut_along({a, b});
     cuts += out.success;
@@ -108,10 +110,11 @@ TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
   }
   std::sort(iterations.begin(), iterations.end());
   const double dihedral_after = mesh_quality(sim.mesh()).min_dihedral_deg;
-  std::printf("TetGen liver, 100 random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
-              "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d)\n",
-              cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before, dihedral_after,
-              iterations[iterations.size() / 2], iterations.back(), cold_iterations);
+  std::printf(
+      "TetGen liver, 100 random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
+      "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d)\n",
+      cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before, dihedral_after,
+      iterations[iterations.size() / 2], iterations.back(), cold_iterations);
   EXPECT_GT(cuts, 30);
 }
 

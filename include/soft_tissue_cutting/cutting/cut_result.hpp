@@ -62,9 +62,9 @@ struct CutResult {
   // Existing nodes whose rest position a cut moved onto the cut surface (their tets are in
   // changed_tets: their element matrices change).
   std::vector<int> moved_nodes;
-  int tets_split = 0;        // parent tets bisected (a tet split twice counts twice)
-  int nodes_added = 0;       // edge nodes + duplicates
-  int cut_faces_added = 0;   // net new cut faces (each face once; a halved one counts 1 more)
+  int tets_split = 0;              // parent tets bisected (a tet split twice counts twice)
+  int nodes_added = 0;             // edge nodes + duplicates
+  int cut_faces_added = 0;         // net new cut faces (each face once; a halved one counts 1 more)
   bool reached_interface = false;  // cut faces dropped so a locked node stays whole
 };
 
