@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The headless demo (SPEC 2, `./tissue demo`, which builds and sources .build/devel/setup.bash
-# first): tissue_node on the built-in thigh + the scripted scalpel (trajectory_player.py)
-# + a bag recording, stopped with SIGINT so the bag closes cleanly; then a summary from the
-# bag, `rosbag info`, and a picture of the cut tissue rendered by rviz under Xvfb.
-# Outputs: out/demo/ (git-ignored: demo.bag, logs, cut_tissue.png) and docs/cut_tissue.png.
+# The headless demo (`./tissue demo [SCENE]`, which builds and sources the workspace first):
+# tissue_node on SCENE + the scripted scalpel (trajectory_player.py playing the scene's
+# `trajectory`) + a bag recording, stopped with SIGINT so the bag closes cleanly; then a summary
+# from the bag, `rosbag info`, and a picture of the cut tissue rendered by rviz under Xvfb.
+# SCENE: `thigh` (default, the built-in scene), the name of a scene in config/scenes/ (e.g.
+# `liver`) or a scene YAML path. Writes ONLY under out/demo/ (git-ignored: demo.bag, logs,
+# cut_tissue.png); `./tissue pictures` is what refreshes the README's pictures in docs/.
 # Environment: TISSUE_DEMO_SECONDS (default 12), TISSUE_DEMO_PICTURE=0 skips the picture.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -16,8 +18,23 @@ mkdir -p "$ROS_HOME"
 if ! command -v roslaunch >/dev/null || [ -z "${ROS_PACKAGE_PATH:-}" ]; then
   set +u
   # shellcheck disable=SC1091
-  source "$ROOT/.build/devel/setup.bash"
+  source "$("$ROOT/tissue" where)"
   set -u
+fi
+scene="${1:-thigh}"
+if [ "$scene" != thigh ]; then
+  if [ -f "$scene" ]; then
+    scene="$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")"
+  elif [ -f "$ROOT/config/scenes/$scene.yaml" ]; then
+    scene="$ROOT/config/scenes/$scene.yaml"
+  else
+    echo "demo: unknown scene '$scene': use thigh, a scene YAML, or one of:" \
+      "$(cd "$ROOT/config/scenes" && ls -- *.yaml | sed 's/\.yaml$//' | tr '\n' ' ')" >&2
+    exit 1
+  fi
+fi
+if [ "$scene" != thigh ] && ! grep -qE '^trajectory:' "$scene"; then
+  echo "demo: note: $(basename "$scene") has no 'trajectory': the node runs without a scalpel"
 fi
 seconds="${TISSUE_DEMO_SECONDS:-12}"
 bag="$OUT/demo.bag"
@@ -25,10 +42,10 @@ rm -f "$bag" "$bag.active"
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://localhost:$port"
 
-echo "demo: thigh + scripted scalpel for ${seconds} s (log: out/demo/roslaunch.log)"
+echo "demo: $(basename "$scene") + scripted scalpel for ${seconds} s (log: out/demo/roslaunch.log)"
 rc=0
 timeout -s INT -k 15 "$seconds" roslaunch -p "$port" soft_tissue_cutting demo.launch \
-  bag:="$bag" >"$OUT/roslaunch.log" 2>&1 || rc=$?
+  scene:="$scene" bag:="$bag" >"$OUT/roslaunch.log" 2>&1 || rc=$?
 # 124: stopped by the SIGINT from timeout, as intended.
 if [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ]; then
   tail -30 "$OUT/roslaunch.log"
@@ -70,9 +87,7 @@ rosbag info "$bag"
 if [ "${TISSUE_DEMO_PICTURE:-1}" != 0 ]; then
   echo "demo: rendering the cut tissue with rviz under Xvfb"
   if "$ROOT/scripts/render_picture.sh" "$bag" "$OUT/cut_tissue.png" >"$OUT/render.log" 2>&1; then
-    mkdir -p "$ROOT/docs"
-    cp "$OUT/cut_tissue.png" "$ROOT/docs/cut_tissue.png"
-    echo "demo: picture out/demo/cut_tissue.png (copied to docs/cut_tissue.png)"
+    echo "demo: picture out/demo/cut_tissue.png"
   else
     tail -10 "$OUT/render.log"
     echo "demo: picture failed (see out/demo/render.log); the demo itself succeeded" >&2

@@ -11,7 +11,12 @@ bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const
   const Vec3 dir = q - p, e1 = b - a, e2 = c - a;
   const Vec3 h = dir.cross(e2);
   const double det = e1.dot(h);
-  if (std::abs(det) < 1e-300) return false;
+  // Relative, not absolute: a triangle collapsed onto a line or a point (e.g. contact has
+  // pulled two of its nodes onto the same blade point, so e1 == e2) has det = 0 only up to
+  // rounding, and 1/det of that rounding noise gave arbitrary barycentrics (a "crossing"
+  // that depended on the compiler's FMA contraction). A degenerate triangle, or a segment
+  // parallel to the plane, has no interior to cross.
+  if (std::abs(det) <= 1e-12 * dir.norm() * e1.norm() * e2.norm()) return false;
   const double inv = 1.0 / det;
   const Vec3 w = p - a;
   const double u = w.dot(h) * inv;
@@ -81,7 +86,8 @@ bool SurfaceBvh::contains(const Vec3& p) const {
   for (int t : candidates) {
     const Tri& n = surface_.triangles[t].nodes;
     double s;
-    crossings += segment_crosses_triangle(p, far, positions_[n[0]], positions_[n[1]], positions_[n[2]], s);
+    crossings +=
+        segment_crosses_triangle(p, far, positions_[n[0]], positions_[n[1]], positions_[n[2]], s);
   }
   return crossings % 2 == 1;
 }

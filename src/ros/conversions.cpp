@@ -67,11 +67,21 @@ soft_tissue_cutting::SimStats to_stats_msg(const StepStats& s, const ModelCounts
   return m;
 }
 
-geometry_msgs::WrenchStamped to_wrench_msg(const StepStats& s) {
+geometry_msgs::WrenchStamped to_wrench_msg(const StepStats& s,
+                                           const std::optional<BladePose>& blade_axes) {
+  Vec3 force = s.contact_force, torque = s.contact_torque;
+  if (blade_axes) {
+    const Eigen::Quaterniond to_blade = blade_axes->orientation.normalized().conjugate();
+    force = to_blade * force;
+    torque = to_blade * torque;
+  }
   geometry_msgs::WrenchStamped w;
-  w.wrench.force.x = s.contact_force.x();
-  w.wrench.force.y = s.contact_force.y();
-  w.wrench.force.z = s.contact_force.z();
+  w.wrench.force.x = force.x();
+  w.wrench.force.y = force.y();
+  w.wrench.force.z = force.z();
+  w.wrench.torque.x = torque.x();
+  w.wrench.torque.y = torque.y();
+  w.wrench.torque.z = torque.z();
   return w;
 }
 

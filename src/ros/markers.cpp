@@ -132,6 +132,20 @@ visualization_msgs::MarkerArray scalpel_markers(const std::optional<BladePose>& 
   return array;
 }
 
+visualization_msgs::Marker contact_marker(const std::vector<Vec3>& held_points) {
+  visualization_msgs::Marker m;
+  m.ns = "contact";
+  m.id = 0;
+  m.type = visualization_msgs::Marker::SPHERE_LIST;
+  m.pose.orientation.w = 1;
+  m.scale.x = m.scale.y = m.scale.z = 0.0015;
+  m.color = rgba(0.2, 0.85, 0.35);
+  m.action =
+      held_points.empty() ? visualization_msgs::Marker::DELETE : visualization_msgs::Marker::ADD;
+  for (const Vec3& p : held_points) m.points.push_back(point(p));
+  return m;
+}
+
 visualization_msgs::MarkerArray operation_region_markers(const OperationRegion& region) {
   visualization_msgs::MarkerArray array;
   visualization_msgs::Marker m;

@@ -14,6 +14,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <stdexcept>
 
@@ -30,6 +31,9 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   pnh.param<double>("max_pose_jump", p.max_pose_jump, p.max_pose_jump);
   pnh.param<double>("display_rate", p.display_rate, p.display_rate);
   pnh.param<std::string>("parent_frame", p.parent_frame, p.parent_frame);
+  pnh.param<std::string>("wrench_frame", p.wrench_frame, p.wrench_frame);
+  if (p.wrench_frame != "tissue" && p.wrench_frame != "blade")
+    throw std::runtime_error("~wrench_frame must be tissue or blade, not '" + p.wrench_frame + "'");
   if (pnh.hasParam("parent_transform") &&
       (!pnh.getParam("parent_transform", p.parent_transform) || p.parent_transform.size() != 7))
     throw std::runtime_error("~parent_transform must be a list of 7 numbers: x y z qx qy qz qw");
@@ -272,8 +276,11 @@ void TissueNode::loop() {
       stats.header.stamp = stamp;
       stats.header.frame_id = params_.frame_id;
       stats_pub_.publish(stats);
-      geometry_msgs::WrenchStamped wrench = to_wrench_msg(s);
+      const bool blade_axes = params_.wrench_frame == "blade";
+      geometry_msgs::WrenchStamped wrench = to_wrench_msg(s, blade_axes ? blade : std::nullopt);
       wrench.header = stats.header;
+      if (blade_axes)
+        wrench.header.frame_id = params_.scalpel_frame.empty() ? "scalpel" : params_.scalpel_frame;
       wrench_pub_.publish(wrench);
 
       // Display (<= display_rate): ~surface when the surface changed, ~markers (always every
@@ -314,7 +321,9 @@ void TissueNode::publish_surface_locked(const ros::Time& stamp) {
   m.header.frame_id = params_.frame_id;
   m.header.stamp = stamp;
   published_version_ = sim_->surface_version();
-  m.text = "surface_version " + std::to_string(published_version_);
+  // The surface state's version travels as the header's sequence number (roscpp sends it as
+  // set), not in `text`: rviz flags a TRIANGLE_LIST with text ("Non-empty text is ignored").
+  m.header.seq = static_cast<std::uint32_t>(published_version_);
   m.action = visualization_msgs::Marker::ADD;
   surface_pub_.publish(m);
   last_surface_pub_ = ros::WallTime::now();
@@ -342,6 +351,7 @@ void TissueNode::publish_markers_locked(const ros::Time& stamp, const DeformedSu
   for (auto& m : scalpel_markers(shown_blade_, sim_->scene().scalpel.blade_length, shown_cutting_)
                      .markers)
     array.markers.push_back(m);
+  array.markers.push_back(contact_marker(sim_->last_stats().contact_points));
   for (auto& m : array.markers) {
     m.header.frame_id = params_.frame_id;
     m.header.stamp = stamp;

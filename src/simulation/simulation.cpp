@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
@@ -8,7 +9,6 @@
 #include "soft_tissue_cutting/cutting/rest_mapping.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
-#include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -39,7 +39,7 @@ struct Simulation::Impl {
   int free_pieces_held = 0;
 
   enum class BladeState { kFree, kPressing, kCutting } blade_state = BladeState::kFree;
-  std::optional<ContactAnchor> anchor;
+  EdgeContact contact;  // the nodes the blade holds while pressing (tip and edge)
   std::optional<BladePose> last_pose;
   std::vector<BladePose> stroke;  // poses of the current cutting stroke
   // The last cut's end edge carried to rest coordinates, and the pose it was carried for: the
@@ -86,7 +86,7 @@ struct Simulation::Impl {
     held.clear();
     free_pieces_held = 0;
     blade_state = BladeState::kFree;
-    anchor.reset();
+    contact.release();
     last_pose.reset();
     stroke.clear();
     last_cut_pose.reset();
@@ -222,67 +222,73 @@ struct Simulation::Impl {
     return out;
   }
 
-  // Operation-part surface triangles near the tip (candidates from the tree).
-  std::vector<BoundaryTriangle> operation_surface_near(const Vec3& tip, double reach) const {
-    std::vector<BoundaryTriangle> out;
-    for (int t : surface_tree.near_segment(tip, tip, reach))
-      if (surface_tree.is_operation(t)) out.push_back(surface_tree.surface().triangles[t]);
-    return out;
-  }
-
   int cut_face_count() const {
     int n = 0;
     for (const auto& t : surface_tree.surface().triangles) n += t.cut;
     return n;
   }
 
+  // Is the edge in the DEFORMED tissue, where the blade is (issue 9)?
+  bool edge_inside_tissue(const BladeEdge& edge) {
+    surface_tree.refit(model->mesh(), displacements());
+    return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length,
+                          [&](const Vec3& p) { return surface_tree.contains(p); });
+  }
+
   StepStats step(const std::optional<BladePose>& blade) {
     const auto t_step = Clock::now();
     StepStats s;
     s.step = ++steps;
-    ImposedDisplacements contact;
+    ImposedDisplacements imposed;
+    const double length = scene.scalpel.blade_length;
     if (!blade) {
       blade_state = BladeState::kFree;
-      anchor.reset();
+      contact.release();
     } else {
-      const Vec3 tip = blade->position;
+      const BladeEdge edge = blade_edge(*blade, length);
       auto t0 = Clock::now();
       if (blade_state == BladeState::kCutting) {
-        // The blade opens the tissue while its tip is in it; out of the tissue, it is free.
-        if (last_pose) cut(*last_pose, *blade, s);
+        // The tissue has yielded: the edge opens it wherever it is in the tissue (the belly
+        // too, the tip may be outside). Lifted out, or sliding through its own incision
+        // (this step's sweep lies in what the stroke has swept already), it is free again;
+        // a fresh press starts a new cut.
+        std::vector<BladeEdge> swept;
+        for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
+        const bool retracing =
+            last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
+        if (last_pose && !retracing) cut(*last_pose, *blade, s);
         stroke.push_back(*blade);
-        surface_tree.refit(model->mesh(), displacements());
-        if (!surface_tree.contains(tip)) {  // the deformed tissue, where the blade is
+        if (retracing || !edge_inside_tissue(edge)) {
           blade_state = BladeState::kFree;
           stroke.clear();
         }
       } else {
-        if (blade_state == BladeState::kFree) {
-          const double reach = 0.5 * scene.scalpel.blade_length;
-          surface_tree.refit(model->mesh(), displacements());
-          anchor = find_contact(model->mesh(), model->displacement(),
-                                operation_surface_near(tip, reach), tip, reach);
-          if (anchor) blade_state = BladeState::kPressing;
-        }
-        if (blade_state == BladeState::kPressing) {
-          if (const auto u = anchored_displacements(*anchor, tip)) {
-            for (int k = 0; k < 3; ++k) contact[anchor->nodes[k]] = (*u)[k];
-          } else {
-            blade_state = BladeState::kFree;
-            anchor.reset();
-          }
-        }
+        surface_tree.refit(model->mesh(), displacements());
+        std::optional<BladeEdge> previous;
+        if (last_pose) previous = blade_edge(*last_pose, length);
+        imposed =
+            contact.update(surface_tree, model->mesh(), model->displacement(), previous, edge);
+        blade_state = contact.empty() ? BladeState::kFree : BladeState::kPressing;
       }
       s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
     }
-    s.converged = solve(contact, s);
-    if (!contact.empty()) {
+    s.converged = solve(imposed, s);
+    if (!imposed.empty()) {
       s.in_contact = true;
-      // The tissue pushes back on the blade with minus the force that holds its nodes.
-      s.contact_force = -model->reaction_force({anchor->nodes.begin(), anchor->nodes.end()});
+      // The tissue pushes back on the blade with minus the force that holds each node; the
+      // torque is about the tip (docs/DESIGN.md (contact)).
+      std::vector<Vec3> force;
+      for (const auto& [node, u] : imposed) {
+        s.contact_nodes.push_back(node);
+        s.contact_points.push_back(model->mesh().nodes[node] + u);
+        force.push_back(model->reaction_force({node}));
+      }
+      const BladeWrench w = blade_wrench(blade->position, s.contact_points, force);
+      s.contact_force = w.force;
+      s.contact_torque = w.torque;
       if (cutting_enabled && s.contact_force.norm() > scene.scalpel.cut_pressure) {
         blade_state = BladeState::kCutting;  // the tissue yields: the next motion cuts
-        anchor.reset();
+        contact.release();
         stroke = {*blade};
       }
     }

@@ -1,7 +1,8 @@
 // (d) Replaying a committed bag of scalpel poses (read with the rosbag C++ API, published on
-// /scalpel/pose in lockstep with the node's steps, original stamps kept): the wrench rises before the cut
-// begins, the surface gains cut faces, and two replays (with ~reset between) end in the same
-// mesh hash (latched std_msgs/String /tissue/mesh_hash). The achieved rate is printed.
+// /scalpel/pose in lockstep with the node's steps, original stamps kept): the wrench rises before
+// the cut begins and carries a torque about the tip, ~markers shows the held nodes (`contact`)
+// while pressing, the surface gains cut faces, and two replays (with ~reset between) end in the
+// same mesh hash (latched std_msgs/String /tissue/mesh_hash). The achieved rate is printed.
 #include "test_helpers.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -29,6 +30,9 @@ struct Replay {
   std::vector<std::pair<ros::Time, double>> force;  // |F| per step
   std::vector<soft_tissue_cutting::SimStats> stats;
   bool cut_faces_shown = false;
+  bool contact_shown = false;       // a `contact` marker with held nodes while pressing
+  double max_torque = 0;            // N m, about the blade tip
+  bool torque_within_blade = true;  // |torque| <= |force| x blade length
   std::string final_hash;
 };
 
@@ -57,7 +61,13 @@ struct Fixture : testing::Test {
         "/tissue/scalpel/wrench", 1000, [this](const geometry_msgs::WrenchStamped::ConstPtr& w) {
           if (!current) return;
           const auto& f = w->wrench.force;
-          current->force.emplace_back(w->header.stamp, std::sqrt(f.x * f.x + f.y * f.y + f.z * f.z));
+          const auto& m = w->wrench.torque;
+          const double force = std::sqrt(f.x * f.x + f.y * f.y + f.z * f.z);
+          const double torque = std::sqrt(m.x * m.x + m.y * m.y + m.z * m.z);
+          current->force.emplace_back(w->header.stamp, force);
+          current->max_torque = std::max(current->max_torque, torque);
+          // The held nodes lie within a blade length (the thigh's 2 cm) of the tip.
+          current->torque_within_blade &= std::isfinite(torque) && torque <= 0.02 * force + 1e-12;
         });
     stats_sub = nh.subscribe<soft_tissue_cutting::SimStats>(
         "/tissue/stats", 1000, [this](const soft_tissue_cutting::SimStats::ConstPtr& s) {
@@ -72,6 +82,9 @@ struct Fixture : testing::Test {
             if (m.ns == "cut_faces" && m.action == visualization_msgs::Marker::ADD &&
                 !m.points.empty())
               current->cut_faces_shown = true;
+            else if (m.ns == "contact" && m.action == visualization_msgs::Marker::ADD &&
+                     !m.points.empty())
+              current->contact_shown = true;
         });
     ASSERT_TRUE(ros::service::waitForService("/tissue/reset", ros::Duration(20)));
     ASSERT_TRUE(spin_until([this] { return pose_pub.getNumSubscribers() > 0; }, 10.0));
@@ -122,10 +135,11 @@ TEST_F(Fixture, ReplayPressesThenCutsAndIsRepeatable) {
     for (const auto& s : r->stats) rates.push_back(s.rate_hz);
     std::nth_element(rates.begin(), rates.begin() + rates.size() / 2, rates.end());
     const auto& last = r->stats.back();
-    std::printf("[bag_replay] %zu poses replayed; %zu steps, median rate %.1f Hz; cuts %u, "
-                "tets_split %u, tets %u; hash %s\n",
-                poses.size(), r->stats.size(), rates[rates.size() / 2], last.cuts,
-                last.tets_split, last.tets, r->final_hash.c_str());
+    std::printf(
+        "[bag_replay] %zu poses replayed; %zu steps, median rate %.1f Hz; cuts %u, "
+        "tets_split %u, tets %u; hash %s\n",
+        poses.size(), r->stats.size(), rates[rates.size() / 2], last.cuts, last.tets_split,
+        last.tets, r->final_hash.c_str());
   }
 
   // The wrench rises before the cut begins.
@@ -138,6 +152,11 @@ TEST_F(Fixture, ReplayPressesThenCutsAndIsRepeatable) {
   ASSERT_FALSE(first.force.empty());
   EXPECT_LT(first.force.front().second, 1e-9) << "the scalpel starts outside the tissue";
   EXPECT_GT(before, 1e-3) << "no reaction force built up before the cut began";
+  // The wrench carries a torque about the tip (the held nodes are off the tip), bounded by
+  // the force times the blade length; rviz showed the held nodes while pressing.
+  EXPECT_GT(first.max_torque, 0);
+  EXPECT_TRUE(first.torque_within_blade);
+  EXPECT_TRUE(first.contact_shown) << "no contact marker while pressing";
 
   // The surface gains cut faces.
   EXPECT_GT(first.stats.back().tets_split, 0u);

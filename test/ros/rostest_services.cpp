@@ -46,7 +46,7 @@ struct Fixture : testing::Test {
     ASSERT_TRUE(spin_until([this] { return !surfaces.empty(); }, 10.0));
   }
 
-  // Calls ~reset and returns the surface the node published right after it (its text names
+  // Calls ~reset and returns the surface the node published right after it (its header.seq is
   // the surface_version the reset response reports).
   bool reset_and_capture(visualization_msgs::Marker* out) {
     std_srvs::Trigger t;
@@ -60,7 +60,7 @@ struct Fixture : testing::Test {
     return spin_until(
         [&] {
           for (const auto& s : surfaces)
-            if (s.text == "surface_version " + version) {
+            if (std::to_string(s.header.seq) == version) {
               *out = s;
               return true;
             }

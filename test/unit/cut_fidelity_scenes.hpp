@@ -1,5 +1,5 @@
 // Meshes and blade strokes for measuring cut fidelity (issue 9): the thigh and TetGen livers
-// made at test time from the SOFA livers in test/data (sofa_liver2.obj, and the boundary of
+// made at test time from the SOFA livers in config/meshes (sofa_liver2.obj, and the boundary of
 // sofa_liver.msh re-meshed), scaled to 15 cm; strokes of a vertical or tilted blade along a
 // straight or curved path at a fixed depth under the rest surface, in steps of any size.
 #pragma once
@@ -29,7 +29,7 @@ inline TetMesh tetgen_liver(const std::string& source, int tets, double extent =
   static std::map<std::pair<std::string, int>, TetMesh> cache;
   const auto key = std::make_pair(source, tets);
   if (auto it = cache.find(key); it != cache.end()) return it->second;
-  const std::string dir = TISSUE_TEST_DATA_DIR;
+  const std::string dir = TISSUE_SHARED_MESH_DIR;
   std::string surface_file = dir + "/sofa_liver2.obj";
   double volume = 0;
   if (source == "liver") {

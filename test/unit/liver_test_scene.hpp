@@ -1,4 +1,4 @@
-// The SOFA livers as test scenes (test/data/MESHES.md), shared by the CalculiX and the
+// The SOFA livers as test scenes (config/meshes/MESHES.md), shared by the CalculiX and the
 // hybrid-vs-full tests. sofa_liver: SOFA's own demo supports (1-based nodes 3 39 64),
 // sofa_liver2: the 10% lowest-x nodes fixed. E = 3000, nu = 0.3. A point load of
 // (0.5, -2, 0.3) N in total on the `loaded` nodes with the largest y, an operation sphere of
@@ -21,7 +21,7 @@ inline Scene liver_scene(const std::string& file, bool gravity, int loaded,
                          OperationRegion::Kind kind = OperationRegion::Kind::kSphere) {
   Scene s;
   s.source = file;
-  s.mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/" + file);
+  s.mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/" + file);
   s.material = Material{3000.0, 0.3, 1000.0};
   Vec3 lo = s.mesh.nodes[0], hi = lo;
   for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);

@@ -81,7 +81,7 @@ Specimen thigh_specimen() {
 }
 
 Specimen liver_specimen() {
-  TetMesh mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver.msh");
+  TetMesh mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver.msh");
   // Operation part: the half of the liver with x above its middle; the rest is condensed.
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
   for (const Vec3& x : mesh.nodes) {

@@ -132,7 +132,7 @@ INSTANTIATE_TEST_SUITE_P(Surfaces, TetrahedralizesSurfaces,
 TEST(SurfaceReader, SofaLiver2Obj) {
   MeshReadOptions options;
   options.tetgen_switches = "pq1.4/10Q";  // coarser than the default for test speed
-  const TetMesh mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver2.obj", options);
+  const TetMesh mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver2.obj", options);
   EXPECT_GT(mesh.num_tets(), 1000);
   expect_positive(mesh);
   EXPECT_TRUE(is_closed_oriented_manifold(extract_boundary_surface(mesh)));
@@ -140,7 +140,7 @@ TEST(SurfaceReader, SofaLiver2Obj) {
 
 TEST(VtkWriter, RoundTripIsBitExact) {
   TempDir dir;
-  TetMesh mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver.msh");
+  TetMesh mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver.msh");
   for (Vec3& x : mesh.nodes) x /= 3.0;  // digits that need all 17
   Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(3 * mesh.num_nodes(), -1e-3, 1e-3);
   std::vector<std::uint8_t> region(static_cast<std::size_t>(mesh.num_tets()), 0);

@@ -7,7 +7,7 @@ namespace {
 TEST(GmshReader, SofaLiverV1) {
   std::vector<std::string> warnings;
   const TetMesh mesh =
-      read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver.msh", {}, &warnings);
+      read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver.msh", {}, &warnings);
   EXPECT_EQ(mesh.num_nodes(), 181);
   EXPECT_EQ(mesh.num_tets(), 596);
   EXPECT_EQ(mesh.nodes[0], Vec3(-0.979259, 2.23512, 2.61245));
@@ -19,7 +19,7 @@ TEST(GmshReader, SofaLiverV1) {
 }
 
 TEST(GmshReader, SofaLiver2V1IgnoresTrianglesAndLines) {
-  const TetMesh mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver2.msh");
+  const TetMesh mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver2.msh");
   EXPECT_EQ(mesh.num_nodes(), 507);
   EXPECT_EQ(mesh.num_tets(), 1493);
   for (int t = 0; t < mesh.num_tets(); ++t) EXPECT_GT(tet_volume(mesh, t), 0);

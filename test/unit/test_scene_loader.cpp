@@ -17,7 +17,7 @@ const std::string kScenes = std::string(TISSUE_TEST_DATA_DIR) + "/../../config/s
 TEST(SceneLoader, LiverExample) {
   const Scene s = load_scene(kScenes + "liver.yaml");
   EXPECT_EQ(s.source, kScenes + "liver.yaml");
-  EXPECT_NE(s.mesh_file.find("test/data/sofa_liver.msh"), std::string::npos);
+  EXPECT_NE(s.mesh_file.find("config/meshes/sofa_liver.msh"), std::string::npos);
   EXPECT_FALSE(s.generator);
   EXPECT_EQ(s.mesh.num_nodes(), 181);
   EXPECT_EQ(s.mesh.num_tets(), 596);

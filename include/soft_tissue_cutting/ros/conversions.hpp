@@ -7,6 +7,7 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <soft_tissue_cutting/SimStats.h>
 
+#include <optional>
 #include <string>
 
 namespace stc {
@@ -24,8 +25,10 @@ soft_tissue_cutting::SimStats to_stats_msg(const StepStats& step, const ModelCou
                                            const std::string& backend,
                                            const std::string& renderer, double rate_hz);
 
-// Reaction force of the tissue on the blade, in the scene frame; torque is not modelled (0).
-geometry_msgs::WrenchStamped to_wrench_msg(const StepStats& step);
+// Force and torque about the blade tip on the blade; in the tissue frame, or in the blade's
+// axes (x along the edge, y its normal) when `blade_axes` gives the blade pose.
+geometry_msgs::WrenchStamped to_wrench_msg(const StepStats& step,
+                                           const std::optional<BladePose>& blade_axes = {});
 
 }  // namespace ros_io
 }  // namespace stc

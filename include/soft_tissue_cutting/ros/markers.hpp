@@ -30,6 +30,10 @@ visualization_msgs::Marker surface_marker(const DeformedSurface& surface, Surfac
 visualization_msgs::MarkerArray scalpel_markers(const std::optional<BladePose>& blade,
                                                 double blade_length, bool cutting);
 
+// The contact region: the surface nodes the blade holds while pressing, as a SPHERE_LIST in
+// namespace "contact" (id 0); a DELETE action when it holds none.
+visualization_msgs::Marker contact_marker(const std::vector<Vec3>& held_points);
+
 // Outline of the operation region (three great circles of the sphere, or the box's edges) in
 // namespace "operation_region"; empty for `all` / `none`.
 visualization_msgs::MarkerArray operation_region_markers(const OperationRegion& region);

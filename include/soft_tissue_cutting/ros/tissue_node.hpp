@@ -49,6 +49,10 @@ struct NodeParams {
   // has its fixed frame. Empty: someone else publishes ~frame_id.
   std::string parent_frame;
   std::vector<double> parent_transform = {0, 0, 0, 0, 0, 0, 1};
+  // ~scalpel/wrench axes: "tissue" (~frame_id) or "blade" (x along the edge, y the blade
+  // normal, z = x cross y; header frame ~scalpel_frame, or "scalpel" without one). The torque
+  // is about the blade tip either way.
+  std::string wrench_frame = "tissue";
 };
 
 // Reads the private parameters; throws std::runtime_error naming a bad one.

@@ -27,6 +27,9 @@ struct StepStats {
   bool in_contact = false;
   bool cutting = false;          // this step inserted a cut
   Vec3 contact_force = Vec3::Zero();  // N, reaction of the tissue on the blade (scene frame)
+  Vec3 contact_torque = Vec3::Zero();  // N m, its moment about the blade tip (scene frame)
+  std::vector<int> contact_nodes;      // the nodes the blade holds this step, ascending
+  std::vector<Vec3> contact_points;    // where it holds them (deformed, scene frame)
   int cg_iterations = 0;
   double residual = 0;
   bool converged = true;

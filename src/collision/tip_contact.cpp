@@ -1,4 +1,4 @@
-#include "soft_tissue_cutting/simulation/scalpel_contact.hpp"
+#include "soft_tissue_cutting/collision/tip_contact.hpp"
 
 #include <limits>
 
