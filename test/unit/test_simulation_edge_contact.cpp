@@ -51,7 +51,7 @@ TestScene liver() {
   s.source = "sofa_liver2.obj";
   MeshReadOptions options;
   options.tetgen_switches = "pq1.4/10Q";
-  s.mesh = read_mesh(std::string(TISSUE_TEST_DATA_DIR) + "/sofa_liver2.obj", options);
+  s.mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver2.obj", options);
   Vec3 lo = s.mesh.nodes[0], hi = lo;
   for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
   const double scale = 0.15 / (hi - lo).maxCoeff();
