@@ -187,9 +187,17 @@ struct Simulation::Impl {
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
     t0 = Clock::now();
     model->update_operation_part(r.changed_tets, r.new_nodes);
-    anchored.resize(static_cast<size_t>(model->mesh().num_nodes()), 0);
-    for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
-      if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
+    // A copy of a held node stays held (both halves of a cut held piece stay put).
+    for (const NewNode& n : r.new_nodes)
+      if (n.kind == NewNode::Kind::kDuplicate)
+        if (const auto it = held.find(n.a); it != held.end()) held[n.index] = it->second;
+    // Anchored = what really holds a node: fixed, on the interface, or held. Recomputed, not
+    // inherited by copies: a copy of an interface node is not attached to the condensed part,
+    // and a node marked anchored without an imposed displacement would count towards the
+    // three anchors of a piece that in fact floats (a singular system; CG stalls).
+    anchored = model->fixed_nodes();
+    for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
+    for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
     hold_free_pieces();
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     s.assembly_ms += ms_since(t0);
