@@ -123,10 +123,10 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   EXPECT_GE(f.covered_area, 0.5 * f.swept_area) << line.str();
 }
 
-// DISABLED (not done): passed before main's edge contact (issue 14) was merged in (contact at
-// 0.0-0.5 mm); with it, a vertical blade pressed tip-first 6 mm into the sagged liver top
-// registers no contact at all. Contact is the edge-contact owner's; reported to the lead.
-TEST(CutFidelityGravity, DISABLED_ContactAsSoonAsTheTipIsInsideTheSaggedSurface) {
+// A vertical blade pressed tip-first into the sagged liver top (a slope ~37 deg from
+// horizontal there) registers contact as soon as its tip is under the deformed surface: the
+// tip anchor (edge_contact.hpp, min_tip_slope), since its line passes no surface node.
+TEST(CutFidelityGravity, ContactAsSoonAsTheTipIsInsideTheSaggedSurface) {
   const Scene scene = sagging_liver();
   Simulation sim(scene);
   const Vec3 top = top_node(sim.mesh());
