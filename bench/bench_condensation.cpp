@@ -1,8 +1,8 @@
 // The paper's Table 1 on the built-in thigh (make_thigh_scene(): 3128 tets, ~2170 of them in
 // the non-operation part): the per-step solve of the condensed (hybrid) model - projected CG
-// on eq. 17 plus the surface recovery u_S = c_S + R u_I - against the general uncondensed
-// model's per-step solve - projected CG on the full K. Like with like: same tolerance, and
-// BOTH sides use the same CG preconditioner (the benchmark argument, in the name and label):
+// on docs/DESIGN.md eq. (10) plus the surface recovery u_S = c_S + R u_I - against the general
+// uncondensed model's per-step solve - projected CG on the full K. Like with like: same tolerance,
+// and BOTH sides use the same CG preconditioner (the benchmark argument, in the name and label):
 //   jacobi:   the paper's plain-CG setting (diagonal scaling only);
 //   cholesky: M = P A^-1 P, A factored once per matrix (solve/linear_solver.hpp).
 //   *_Cold: both start from zero every step (the paper's setting: a full static solve).
@@ -54,7 +54,9 @@ const Scene& thigh(int region = 0) {
   static const Scene coarse = make_small_region_thigh();
   return region == 0 ? refined : coarse;
 }
-const Scene& thigh(const benchmark::State& state) { return thigh(static_cast<int>(state.range(1))); }
+const Scene& thigh(const benchmark::State& state) {
+  return thigh(static_cast<int>(state.range(1)));
+}
 int contact_node(const benchmark::State& state) { return thigh(state).loads[0].where.nodes[0]; }
 
 CgPreconditioner preconditioner(const benchmark::State& state) {
@@ -81,7 +83,7 @@ void BM_Table1_CondensedStep_Cold(benchmark::State& state) {
   CgResult r;
   for (auto _ : state) {
     h.reset_displacement();
-    r = h.solve();  // CG on eq. 17 + u_S = c_S + R u_I
+    r = h.solve();  // CG on docs/DESIGN.md eq. (10) + u_S = c_S + R u_I
     benchmark::DoNotOptimize(h.displacement().data());
   }
   state.counters["dof"] = h.counts().dof_operation;
@@ -165,10 +167,16 @@ void BM_Table1_GeneralFactor(benchmark::State& state) {
 }
 
 // precond 0: Jacobi, 1: Cholesky; region 0: built-in thigh, 1: small (paper-like) region.
-#define STC_TABLE1(fn)                                                                   \
-  BENCHMARK(fn)->ArgNames({"precond", "region"})->ArgsProduct({{0, 1}, {0, 1}})          \
-      ->Unit(benchmark::kMillisecond)->Repetitions(15)->ReportAggregatesOnly(true)
-BENCHMARK(BM_Precompute)->Unit(benchmark::kMillisecond)->Repetitions(15)
+#define STC_TABLE1(fn)                  \
+  BENCHMARK(fn)                         \
+      ->ArgNames({"precond", "region"}) \
+      ->ArgsProduct({{0, 1}, {0, 1}})   \
+      ->Unit(benchmark::kMillisecond)   \
+      ->Repetitions(15)                 \
+      ->ReportAggregatesOnly(true)
+BENCHMARK(BM_Precompute)
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(15)
     ->ReportAggregatesOnly(true);
 STC_TABLE1(BM_Table1_CondensedStep_Cold);
 STC_TABLE1(BM_Table1_GeneralStep_Cold);

@@ -48,7 +48,8 @@ void BM_CuttingSweep(benchmark::State& state) {
     const int tets_before = mesh.num_tets();
     state.ResumeTiming();
     for (int k = 0; k < steps; ++k) {
-      const BladeEdge from = edge_at(static_cast<double>(k) / steps), to = edge_at(static_cast<double>(k + 1) / steps);
+      const BladeEdge from = edge_at(static_cast<double>(k) / steps),
+                      to = edge_at(static_cast<double>(k + 1) / steps);
       bvh.refit(mesh, {});
       benchmark::DoNotOptimize(blade_contact(bvh, mesh, to, 1e-6));
       const CutResult r = cut_sweep(mesh, cut, from, to);
@@ -62,11 +63,16 @@ void BM_CuttingSweep(benchmark::State& state) {
   state.counters["sweeps_per_stroke"] = steps;
   state.counters["tets_added_per_cm"] = static_cast<double>(tets_added) / sweeps / cut_cm;
   // Seconds per sweep (shown with an SI prefix, e.g. 380u = 0.38 ms).
-  state.counters["s_per_sweep"] = benchmark::Counter(
-      static_cast<double>(steps), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["s_per_sweep"] =
+      benchmark::Counter(static_cast<double>(steps), benchmark::Counter::kIsIterationInvariantRate |
+                                                         benchmark::Counter::kInvert);
 }
 // 1 sweep for the whole 4 cm stroke, and 20 sweeps of 2 mm (a 100 Hz loop at 20 cm/s).
-BENCHMARK(BM_CuttingSweep)->Arg(1)->Arg(20)->Unit(benchmark::kMillisecond)->Repetitions(5)
+BENCHMARK(BM_CuttingSweep)
+    ->Arg(1)
+    ->Arg(20)
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
     ->ReportAggregatesOnly(true);
 
 }  // namespace

@@ -1,12 +1,12 @@
-// GPU texture SpMV and whole-CG benchmarks (METHOD.md section 6; the paper's Table 2 in
-// section 7). Rows of Table 2 are synthesized: SPD matrices with the same DOF and the same
+// GPU texture SpMV and whole-CG benchmarks (docs/DESIGN.md section 9; the paper's Table 2 in
+// section 13). Rows of Table 2 are synthesized: SPD matrices with the same DOF and the same
 // longest row (off-diagonal non-zeros 188..237, reached by a dense interface block), run
 // with Method A, Method B, our one-pass RowLoop layout, and the CPU (Eigen CSR, double).
 // Then a scaling run of whole CG iterations at 10k, 100k, 1M DOF.
 //
 // The device is named in the context ("gl_renderer") and in each GPU label. On Mesa
 // llvmpipe (software rasterizer on the CPU) the numbers say nothing about real GPU speed,
-// only about pass overheads; RECIPES.md: llvmpipe is for correctness.
+// only about pass overheads; docs/DESIGN.md section 14: llvmpipe is for correctness.
 // Times are per SpMV / per CG iteration; use --benchmark_repetitions for medians.
 #include "soft_tissue_cutting/gpu/egl_context.hpp"
 #include "soft_tissue_cutting/gpu/gl_cg.hpp"
@@ -50,7 +50,8 @@ Gl& gl() {
 const SparseMatrix& table2(int dof, int max_row) {
   static std::map<std::pair<int, int>, SparseMatrix> cache;
   auto it = cache.find({dof, max_row});
-  if (it == cache.end()) it = cache.emplace(std::make_pair(dof, max_row), table2_matrix(dof, max_row)).first;
+  if (it == cache.end())
+    it = cache.emplace(std::make_pair(dof, max_row), table2_matrix(dof, max_row)).first;
   return it->second;
 }
 
@@ -157,7 +158,7 @@ void cpu_cg(benchmark::State& state, const SparseMatrix& a) {
   state.SetLabel("cpu jacobi-pcg double");
 }
 
-const int kTable2[7][2] = {{456, 188}, {960, 188}, {1137, 188}, {1602, 188},
+const int kTable2[7][2] = {{456, 188},  {960, 188},  {1137, 188}, {1602, 188},
                            {1854, 190}, {2100, 231}, {2190, 237}};
 const SpmvLayout kLayouts[3] = {SpmvLayout::MethodA, SpmvLayout::MethodB, SpmvLayout::RowLoop};
 
@@ -173,19 +174,26 @@ int register_all() {
     const std::string tag = "/dof:" + std::to_string(dof) + "/max_row:" + std::to_string(max_row);
     for (SpmvLayout l : kLayouts) {
       if (!g.ctx) break;
-      benchmark::RegisterBenchmark(("Table2_SpMV/" + layout_name(l) + tag).c_str(),
-                                   [=](benchmark::State& s) { gpu_spmv(s, table2(dof, max_row), l); })
-          ->Unit(benchmark::kMillisecond)->MinTime(0.05);
-      benchmark::RegisterBenchmark(("Table2_CgIter/" + layout_name(l) + tag).c_str(),
-                                   [=](benchmark::State& s) { gpu_cg(s, table2(dof, max_row), l, 8); })
-          ->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.05);
+      benchmark::RegisterBenchmark(
+          ("Table2_SpMV/" + layout_name(l) + tag).c_str(),
+          [=](benchmark::State& s) { gpu_spmv(s, table2(dof, max_row), l); })
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.05);
+      benchmark::RegisterBenchmark(
+          ("Table2_CgIter/" + layout_name(l) + tag).c_str(),
+          [=](benchmark::State& s) { gpu_cg(s, table2(dof, max_row), l, 8); })
+          ->Unit(benchmark::kMillisecond)
+          ->UseManualTime()
+          ->MinTime(0.05);
     }
     benchmark::RegisterBenchmark(("Table2_SpMV/cpu" + tag).c_str(),
                                  [=](benchmark::State& s) { cpu_spmv(s, table2(dof, max_row)); })
-        ->Unit(benchmark::kMillisecond)->MinTime(0.05);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.05);
     benchmark::RegisterBenchmark(("Table2_CgIter/cpu" + tag).c_str(),
                                  [=](benchmark::State& s) { cpu_cg(s, table2(dof, max_row)); })
-        ->Unit(benchmark::kMillisecond)->MinTime(0.05);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.05);
   }
   // Scaling of whole CG iterations (3D elasticity-like, 20 off-diagonal non-zeros per row).
   // Fixed iteration counts (and 4 instead of 8 CG iterations per read-back at 1M) keep the
@@ -195,15 +203,22 @@ int register_all() {
     const int bench_iters = dof > 500000 ? 1 : dof > 50000 ? 4 : 0;  // 0: automatic
     for (SpmvLayout l : kLayouts) {
       if (!g.ctx) break;
-      auto* b = benchmark::RegisterBenchmark(("Scaling_CgIter/" + layout_name(l) + tag).c_str(),
-                                             [=](benchmark::State& s) { gpu_cg(s, scaling(dof), l, dof > 500000 ? 4 : 8); });
+      auto* b = benchmark::RegisterBenchmark(
+          ("Scaling_CgIter/" + layout_name(l) + tag).c_str(),
+          [=](benchmark::State& s) { gpu_cg(s, scaling(dof), l, dof > 500000 ? 4 : 8); });
       b->Unit(benchmark::kMillisecond)->UseManualTime();
-      if (bench_iters) b->Iterations(bench_iters); else b->MinTime(0.05);
+      if (bench_iters)
+        b->Iterations(bench_iters);
+      else
+        b->MinTime(0.05);
     }
     auto* b = benchmark::RegisterBenchmark(("Scaling_CgIter/cpu" + tag).c_str(),
                                            [=](benchmark::State& s) { cpu_cg(s, scaling(dof)); });
     b->Unit(benchmark::kMillisecond);
-    if (bench_iters) b->Iterations(8 * bench_iters); else b->MinTime(0.05);
+    if (bench_iters)
+      b->Iterations(8 * bench_iters);
+    else
+      b->MinTime(0.05);
   }
   return 0;
 }

@@ -1,6 +1,6 @@
-// Whole simulation steps on the built-in thigh (METHOD 5): the scripted scalpel presses and
-// then cuts. A cutting step = collision + cut insertion + re-assembly of the changed tets +
-// hybrid CG solve + surface recovery. Median and max over every cutting step of the stroke,
+// Whole simulation steps on the built-in thigh (docs/DESIGN.md section 10): the scripted scalpel
+// presses and then cuts. A cutting step = collision + cut insertion + re-assembly of the changed
+// tets + hybrid CG solve + surface recovery. Median and max over every cutting step of the stroke,
 // and tets added per cm of cut. (Issue 4's target: median under 5 ms on one core.) A cutting
 // step's solver share: CG iterations, and set_matrix (the Cholesky preconditioner's
 // factorization of the changed hybrid matrix) inside assembly_ms.
@@ -72,7 +72,8 @@ void BM_ThighStrokeSteps(benchmark::State& state) {
       previous = p;
     }
     state.PauseTiming();
-    if (travelled_at_first_cut >= 0) cut_length_cm += travelled_at_last_cut - travelled_at_first_cut;
+    if (travelled_at_first_cut >= 0)
+      cut_length_cm += travelled_at_last_cut - travelled_at_first_cut;
     tets_added += sim.mesh().num_tets() - tets0;
     state.ResumeTiming();
   }
@@ -87,8 +88,9 @@ void BM_ThighStrokeSteps(benchmark::State& state) {
       static_cast<double>(cutting_ms.size()) / static_cast<double>(state.iterations());
   state.counters["tets_added_per_cm"] = cut_length_cm > 0 ? tets_added / cut_length_cm : 0;
   state.SetLabel("thigh " + std::to_string(scene.mesh.num_tets()) + " tets, hybrid DOF " +
-                 std::to_string(sim.counts().dof_operation) + ", " + sim.model().solver().backend() +
-                 " CG, preconditioner " + sim.model().solver().preconditioner());
+                 std::to_string(sim.counts().dof_operation) + ", " +
+                 sim.model().solver().backend() + " CG, preconditioner " +
+                 sim.model().solver().preconditioner());
 }
 // 10 and 40 poses per trajectory segment: 2 mm and 0.5 mm of blade travel per step.
 BENCHMARK(BM_ThighStrokeSteps)->Arg(10)->Arg(40)->Unit(benchmark::kMillisecond);

@@ -12,7 +12,8 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$ROOT/out/demo"
 mkdir -p "$OUT"
 export PATH="/usr/bin:/bin:$PATH"
-export ROS_HOSTNAME=localhost
+export ROS_IP=127.0.0.1  # no name resolution needed (not even localhost)
+unset ROS_HOSTNAME
 export ROS_HOME="$OUT/ros_home"
 mkdir -p "$ROS_HOME"
 if ! command -v roslaunch >/dev/null || [ -z "${ROS_PACKAGE_PATH:-}" ]; then
@@ -40,7 +41,7 @@ seconds="${TISSUE_DEMO_SECONDS:-12}"
 bag="$OUT/demo.bag"
 rm -f "$bag" "$bag.active"
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
-export ROS_MASTER_URI="http://localhost:$port"
+export ROS_MASTER_URI="http://127.0.0.1:$port"
 
 echo "demo: $(basename "$scene") + scripted scalpel for ${seconds} s (log: out/demo/roslaunch.log)"
 rc=0

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # render_picture.sh BAG PNG [SECONDS]: replays a bag's /tissue/surface and /tissue/markers into
-# rviz (config/tissue.rviz) on a virtual X display and saves a screenshot (RECIPES.md: Xvfb +
+# rviz (config/tissue.rviz) on a virtual X display and saves a screenshot (docs/DESIGN.md
+# section 14: Xvfb +
 # `import -window root`). Needs the workspace sourced, xvfb-run, rviz and imagemagick.
 set -euo pipefail
 bag="$1" png="$2" wait_s="${3:-}"

@@ -5,7 +5,8 @@ Add an "InteractiveMarkers" display on /scalpel_marker/update in rviz and drag t
 Parameters: ~frame_id (tissue), ~initial_position ([0.09, 0.003, 0.028]: outside the thigh's
 operation region), ~initial_orientation ([0, 0, 0, 1]), ~blade_length (0.02 m, drawing only),
 ~rate (Hz, 30: the current pose is republished so the node always has a fresh one).
-The pose origin is the blade tip; the cutting edge runs along local +x (SPEC 3 `scalpel`).
+The pose origin is the blade tip; the cutting edge runs along local +x (docs/SCENE.md "Scene
+file", `scalpel`).
 """
 import copy
 

@@ -1,4 +1,4 @@
-// First pass of a dot product (METHOD.md section 6, "sum reduction: repeated halving
+// First pass of a dot product (docs/DESIGN.md section 9, "sum reduction: repeated halving
 // passes"): each output texel multiplies and sums a 2x2 block of two vectors, giving
 // (sum a*b, sum a*a) in RG: (r.z, r.r) in one go for CG, or (p.q, -) for alpha.
 uniform sampler2D u_a;

@@ -1,4 +1,4 @@
-// Full-screen quad for every fragment pass (METHOD.md section 6): four corners from
+// Full-screen quad for every fragment pass (docs/DESIGN.md section 9): four corners from
 // gl_VertexID drawn as a triangle strip, no vertex buffers. Each fragment = one texel of the
 // render target = one vector entry (or one partial sum of a reduction).
 void main() {

@@ -1,4 +1,4 @@
-// Halving pass of a sum reduction (METHOD.md section 6): each output texel sums a 2x2 block
+// Halving pass of a sum reduction (docs/DESIGN.md section 9): each output texel sums a 2x2 block
 // of the previous level (RG channels); repeated, ping-ponging down the chain, until 1x1.
 uniform sampler2D u_src;
 uniform ivec2 u_src_size;

@@ -1,4 +1,4 @@
-// SpMV y = A x, Method A of the paper (METHOD.md section 6): Telement holds ONE off-diagonal
+// SpMV y = A x, Method A of the paper (docs/DESIGN.md section 9): Telement holds ONE off-diagonal
 // non-zero per texel (value bits and column packed in an RG32I texel), Tindex the row's start
 // texel and count. Pass k adds the k-th non-zero of every row, so a full SpMV needs as many
 // passes as the longest row; the running sum ping-pongs between two render targets.

@@ -1,4 +1,4 @@
-// SpMV y = A x, Method B of the paper (METHOD.md section 6): four off-diagonal non-zeros per
+// SpMV y = A x, Method B of the paper (docs/DESIGN.md section 9): four off-diagonal non-zeros per
 // RGBA32F Telement texel (rows padded to a multiple of 4 with zeros), their x texel
 // coordinates in two index textures Tst-a (s0,t0,s1,t1) and Tst-b (s2,t2,s3,t3). Pass k adds
 // the k-th group of four: ceil(longest row / 4) passes, ping-pong as in Method A.

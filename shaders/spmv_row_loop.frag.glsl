@@ -1,4 +1,4 @@
-// SpMV y = A x in ONE pass (our layout, the paper's future work in METHOD.md section 6): the
+// SpMV y = A x in ONE pass (our layout, the paper's future work in docs/DESIGN.md section 9): the
 // same 4-wide RGBA32F value blocks as Method B plus one RGBA32I texture of 4 columns; each
 // fragment loops over its own row. The pass count is 1 whatever the longest row: dense
 // interface rows cost their own fragments more time but no extra passes over the whole vector.

@@ -1,8 +1,10 @@
 // ./tissue solve SCENE.yaml [--out OUT.vtk] [--stats OUT.json] [--backend cpu|gl]
-// The offline run of SPEC section 4: load, precompute the condensation, play the scene's
-// trajectory (pressure-triggered cuts included), solve the final equilibrium, write outputs.
+// The offline run of docs/SCENE.md "Offline run": load, precompute the condensation, play the
+// scene's trajectory (pressure-triggered cuts included), solve the final equilibrium, write
+// outputs.
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
+#include "soft_tissue_cutting/simulation/step_times.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -53,28 +55,53 @@ int main(int argc, char** argv) {
     stc::SimulationOptions options;
     options.backend = backend;
     stc::Simulation sim(stc::load_scene(scene_path), options);
-    if (!sim.backend_note().empty()) std::fprintf(stderr, "tissue solve: %s\n", sim.backend_note().c_str());
+    if (!sim.backend_note().empty())
+      std::fprintf(stderr, "tissue solve: %s\n", sim.backend_note().c_str());
+    // A gl solve finished on the cpu says so once per distinct reason (not once per step).
+    std::string last_fallback;
+    const auto report_fallback = [&last_fallback](const stc::StepStats& s, const char* when) {
+      if (s.fallback_reason.empty() || s.fallback_reason == last_fallback) return;
+      std::fprintf(stderr, "tissue solve: %s: %s\n", when, s.fallback_reason.c_str());
+      last_fallback = s.fallback_reason;
+    };
+    report_fallback(sim.last_stats(), "initial equilibrium");
     // Step at the trajectory's poses (the scene's times), then once more without the
     // scalpel: the final static equilibrium.
     for (const stc::BladePose& pose : sim.scene().trajectory) {
       const stc::StepStats s = sim.step(pose);
+      char when[32];
+      std::snprintf(when, sizeof when, "t=%.3f", pose.t);
+      report_fallback(s, when);
       if (s.reached_interface)
-        std::fprintf(stderr, "tissue solve: t=%.3f: the blade reached the interface of the "
-                     "condensed part; cutting stops there\n", pose.t);
+        std::fprintf(stderr,
+                     "tissue solve: t=%.3f: the blade reached the interface of the "
+                     "condensed part; cutting stops there\n",
+                     pose.t);
     }
+    // step_ms times the trajectory's steps only, not the final equilibrium solve.
+    const stc::StepTimes trajectory_steps = sim.step_times();
     const stc::StepStats final_step = sim.step(std::nullopt);
-    if (!final_step.converged)
-      std::fprintf(stderr, "tissue solve: warning: CG did not converge (relative residual %.3g)\n",
-                   final_step.residual);
+    report_fallback(final_step, "final solve");
     const double total_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!out.empty()) sim.write_vtk(out);
-    if (!stats.empty()) sim.write_stats_json(stats, total_ms);
+    if (!stats.empty()) sim.write_stats_json(stats, total_ms, &trajectory_steps);
     const stc::ModelCounts c = sim.counts();
-    std::printf("solved %s: %d nodes, %d tets, %d cuts, %ld CG iterations in all, residual %.3g, "
-                "backend %s, %.1f ms\n",
-                scene_path.c_str(), c.nodes, c.tets, c.cuts, c.cg_iterations_total,
-                final_step.residual, sim.backend().c_str(), total_ms);
+    std::printf(
+        "solved %s: %d nodes, %d tets, %d cuts, %ld CG iterations in all, residual %.3g, "
+        "backend %s, %.1f ms\n",
+        scene_path.c_str(), c.nodes, c.tets, c.cuts, c.cg_iterations_total, final_step.residual,
+        (final_step.solved_by.empty() ? sim.backend() : final_step.solved_by).c_str(), total_ms);
+    // docs/SCENE.md (solve contract): exit 3, after the outputs, when the final solve did not
+    // converge.
+    if (!final_step.converged) {
+      char fallback[64];
+      std::snprintf(fallback, sizeof fallback, "relative residual %.3g", final_step.residual);
+      std::fprintf(
+          stderr, "tissue solve: the final solve did not converge: %s\n",
+          final_step.solver_message.empty() ? fallback : final_step.solver_message.c_str());
+      return 3;
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tissue solve: %s\n", e.what());

@@ -5,8 +5,8 @@ namespace {
 
 Mat12 stiffness_of(const TetMesh& mesh, int t, const Material& m) {
   const Tet& e = mesh.tets[static_cast<size_t>(t)];
-  return element_stiffness(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                           mesh.nodes[e[3]], m.young_modulus, m.poisson_ratio);
+  return element_stiffness(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]], mesh.nodes[e[3]],
+                           m.young_modulus, m.poisson_ratio);
 }
 
 }  // namespace

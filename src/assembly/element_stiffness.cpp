@@ -34,18 +34,18 @@ StrainDisplacement strain_displacement(const Vec3& x0, const Vec3& x1, const Vec
   for (int a = 0; a < 4; ++a) {
     const double gx = g(0, a), gy = g(1, a), gz = g(2, a);
     const int c = 3 * a;
-    b(0, c) = gx;                      // eps_xx
-    b(1, c + 1) = gy;                  // eps_yy
-    b(2, c + 2) = gz;                  // eps_zz
-    b(3, c) = gy, b(3, c + 1) = gx;    // gamma_xy
+    b(0, c) = gx;                        // eps_xx
+    b(1, c + 1) = gy;                    // eps_yy
+    b(2, c + 2) = gz;                    // eps_zz
+    b(3, c) = gy, b(3, c + 1) = gx;      // gamma_xy
     b(4, c + 1) = gz, b(4, c + 2) = gy;  // gamma_yz
-    b(5, c) = gz, b(5, c + 2) = gx;    // gamma_zx
+    b(5, c) = gz, b(5, c + 2) = gx;      // gamma_zx
   }
   return b;
 }
 
-Mat12 element_stiffness(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3,
-                        double e, double nu) {
+Mat12 element_stiffness(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3, double e,
+                        double nu) {
   const double v = signed_volume(x0, x1, x2, x3);
   if (!(v > 0)) throw std::invalid_argument("element_stiffness: tet with non-positive volume");
   const StrainDisplacement b = strain_displacement(x0, x1, x2, x3);

@@ -25,8 +25,8 @@ FullModel assemble_full_model(const TetMesh& mesh, const ElementStiffnessCache& 
 
 FullModel assemble_full_model(const Scene& scene) {
   const ElementStiffnessCache elements(scene.mesh, scene.material);
-  const Vector f = point_loads(scene) +
-                   gravity_loads(scene.mesh, scene.material.density, scene.gravity);
+  const Vector f =
+      point_loads(scene) + gravity_loads(scene.mesh, scene.material.density, scene.gravity);
   return assemble_full_model(scene.mesh, elements, f, fixed_node_mask(scene));
 }
 

@@ -7,8 +7,8 @@ Vector point_loads(const Scene& scene) {
   for (const Load& load : scene.loads) {
     const std::vector<int> nodes = load.where.select(scene.mesh);
     if (nodes.empty()) continue;
-    const Vec3 per_node = load.total ? Vec3(load.force / static_cast<double>(nodes.size()))
-                                     : load.force;
+    const Vec3 per_node =
+        load.total ? Vec3(load.force / static_cast<double>(nodes.size())) : load.force;
     for (int n : nodes) f.segment<3>(3 * n) += per_node;
   }
   return f;

@@ -31,7 +31,8 @@ int AabbTree::build_node(const std::vector<Box3>& boxes, int first, int count) {
   int axis;
   box.sizes().maxCoeff(&axis);
   const int half = count / 2;
-  std::nth_element(order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
+  std::nth_element(order_.begin() + first, order_.begin() + first + half,
+                   order_.begin() + first + count,
                    [&](int a, int b) { return boxes[a].center()[axis] < boxes[b].center()[axis]; });
   const int left = build_node(boxes, first, half);
   const int right = build_node(boxes, first + half, count - half);

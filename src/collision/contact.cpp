@@ -10,7 +10,8 @@ BladeContact blade_contact(const SurfaceBvh& bvh, const TetMesh& mesh, const Bla
   BladeContact contact;
   std::map<int, Vec3> touched;  // node -> closest blade point
   auto touch = [&](int v) {
-    if (!touched.count(v)) touched[v] = closest_point_on_segment(edge.tip, edge.heel, bvh.position(v));
+    if (!touched.count(v))
+      touched[v] = closest_point_on_segment(edge.tip, edge.heel, bvh.position(v));
   };
   for (int t : bvh.near_segment(edge.tip, edge.heel, touch_distance)) {
     if (!bvh.is_operation(t)) continue;
@@ -30,8 +31,8 @@ BladeContact blade_contact(const SurfaceBvh& bvh, const TetMesh& mesh, const Bla
       continue;
     }
     for (int v : n)
-      if ((closest_point_on_segment(edge.tip, edge.heel, bvh.position(v)) - bvh.position(v)).norm() <=
-          touch_distance)
+      if ((closest_point_on_segment(edge.tip, edge.heel, bvh.position(v)) - bvh.position(v))
+              .norm() <= touch_distance)
         touch(v);
   }
   std::sort(contact.crossed_triangles.begin(), contact.crossed_triangles.end());

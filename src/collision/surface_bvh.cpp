@@ -48,7 +48,13 @@ std::vector<Box3> SurfaceBvh::triangle_boxes() const {
 
 void SurfaceBvh::build(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
                        const std::vector<Vec3>& displacement) {
-  surface_ = extract_boundary_surface(mesh);
+  build(extract_boundary_surface(mesh), mesh, operation_tets, displacement);
+}
+
+void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
+                       const std::vector<std::uint8_t>& operation_tets,
+                       const std::vector<Vec3>& displacement) {
+  surface_ = std::move(surface);
   operation_.resize(surface_.triangles.size());
   for (size_t i = 0; i < surface_.triangles.size(); ++i)
     operation_[i] = operation_tets.empty() || operation_tets[surface_.triangles[i].tet];

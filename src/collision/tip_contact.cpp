@@ -65,7 +65,8 @@ std::optional<ContactAnchor> find_contact(const TetMesh& mesh, const Eigen::Vect
     best = ContactAnchor{t.nodes,
                          {x[0] - mesh.nodes[t.nodes[0]], x[1] - mesh.nodes[t.nodes[1]],
                           x[2] - mesh.nodes[t.nodes[2]]},
-                         q, n.normalized()};
+                         q,
+                         n.normalized()};
   }
   return best;
 }

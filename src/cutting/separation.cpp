@@ -77,7 +77,8 @@ struct Duplication {
 };
 
 std::uint64_t edge_key(int a, int b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+         static_cast<std::uint32_t>(b);
 }
 
 // Edges that would lie in other than exactly two (oppositely wound) boundary triangles after
@@ -102,7 +103,9 @@ std::vector<std::pair<int, int>> planned_bad_edges(const TetMesh& mesh, const Cu
     auto it = renamed.find(t);
     return it == renamed.end() ? mesh.tets[t] : it->second;
   };
-  auto current_id = [&](int v) { return v < mesh.num_nodes() ? v : original[v - mesh.num_nodes()]; };
+  auto current_id = [&](int v) {
+    return v < mesh.num_nodes() ? v : original[v - mesh.num_nodes()];
+  };
 
   std::unordered_set<int> inner_tets, watched_nodes, outer_tets;
   for (const Duplication& d : plan)
@@ -117,7 +120,8 @@ std::vector<std::pair<int, int>> planned_bad_edges(const TetMesh& mesh, const Cu
     const Tet tet = planned(t);
     for (int f = 0; f < 4; ++f) {
       const Tri tri = {tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
-      if (!watched_nodes.count(tri[0]) && !watched_nodes.count(tri[1]) && !watched_nodes.count(tri[2]))
+      if (!watched_nodes.count(tri[0]) && !watched_nodes.count(tri[1]) &&
+          !watched_nodes.count(tri[2]))
         continue;
       FaceKey key = {tri[0], tri[1], tri[2]};
       std::sort(key.begin(), key.end());
@@ -137,7 +141,8 @@ std::vector<std::pair<int, int>> planned_bad_edges(const TetMesh& mesh, const Cu
   std::vector<std::pair<int, int>> bad;
   for (const auto& [key, count] : directed) {
     const int p = static_cast<int>(key >> 32), q = static_cast<int>(key & 0xffffffffu);
-    if (count != 1 || !directed.count(edge_key(q, p))) bad.emplace_back(current_id(p), current_id(q));
+    if (count != 1 || !directed.count(edge_key(q, p)))
+      bad.emplace_back(current_id(p), current_id(q));
   }
   return bad;
 }
@@ -179,8 +184,9 @@ void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>&
     int dropped = 0;
     for (const auto& [p, q] : bad) {
       int here = unmark_closed_faces(mesh, state, {p, q}, new_faces);
-      if (here == 0) here = unmark_closed_faces(mesh, state, {p}, new_faces) +
-                            unmark_closed_faces(mesh, state, {q}, new_faces);
+      if (here == 0)
+        here = unmark_closed_faces(mesh, state, {p}, new_faces) +
+               unmark_closed_faces(mesh, state, {q}, new_faces);
       dropped += here;
     }
     if (dropped == 0) break;  // nothing closed left to drop: cannot happen from a valid state

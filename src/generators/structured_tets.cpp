@@ -7,7 +7,8 @@ namespace stc::detail {
 void add_kuhn_tets(int ni, int nj, int nk, const std::function<int(int, int, int)>& node_index,
                    TetMesh& mesh) {
   // The six monotone paths from corner (0,0,0) to (1,1,1), one tet each.
-  static const int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  static const int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                   {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
   for (int i = 0; i < ni; ++i)
     for (int j = 0; j < nj; ++j)
       for (int k = 0; k < nk; ++k)

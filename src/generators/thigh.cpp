@@ -19,7 +19,8 @@ int scaled_count(int base, double resolution) {
 TetMesh make_thigh_mesh(const GeneratorParams& p) {
   if (!(p.inner_radius > 0) || !(p.outer_radius > p.inner_radius) || !(p.length > 0) ||
       !(p.resolution > 0))
-    throw std::invalid_argument("thigh generator: need 0 < inner_radius < outer_radius, length > 0, resolution > 0");
+    throw std::invalid_argument(
+        "thigh generator: need 0 < inner_radius < outer_radius, length > 0, resolution > 0");
   // Default resolution: 2 x 13 x 6 cells = 936 tets, 273 nodes; make_thigh_scene refines
   // the operation region from there. Radii are graded geometrically so every cell is close
   // to a cube (radial step ~ circumferential step), which keeps the Kuhn tets' dihedral
@@ -53,8 +54,8 @@ TetMesh make_box_mesh(const GeneratorParams& p) {
   for (int k = 0; k <= n[2]; ++k)
     for (int j = 0; j <= n[1]; ++j)
       for (int i = 0; i <= n[0]; ++i)
-        mesh.nodes[index(i, j, k)] = Vec3(p.size.x() * i / n[0], p.size.y() * j / n[1],
-                                          p.size.z() * k / n[2]);
+        mesh.nodes[index(i, j, k)] =
+            Vec3(p.size.x() * i / n[0], p.size.y() * j / n[1], p.size.z() * k / n[2]);
   detail::add_kuhn_tets(n[0], n[1], n[2], index, mesh);
   return mesh;
 }

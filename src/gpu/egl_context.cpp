@@ -54,17 +54,28 @@ bool has_extension(const char* list, const char* name) {
 
 std::string egl_error_name(EGLint e) {
   switch (e) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
+    case EGL_SUCCESS:
+      return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED:
+      return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+      return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+      return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+      return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+      return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+      return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY:
+      return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+      return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER:
+      return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE:
+      return "EGL_BAD_SURFACE";
     default: {
       std::ostringstream s;
       s << "EGL error 0x" << std::hex << e;
@@ -124,7 +135,8 @@ std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
   std::vector<Candidate> candidates;
   device_candidates(client_ext, candidates, notes);
   if (has_extension(client_ext, "EGL_MESA_platform_surfaceless")) {
-    EGLDisplay d = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLDisplay d =
+        eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
     if (d != EGL_NO_DISPLAY)
       candidates.push_back({d, "EGL surfaceless platform"});
     else
@@ -152,18 +164,21 @@ std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
       if (desktop && gles_only) continue;
       if (!eglBindAPI(desktop ? EGL_OPENGL_API : EGL_OPENGL_ES_API)) continue;
       const EGLint config_attribs[] = {EGL_SURFACE_TYPE, surfaceless ? 0 : EGL_PBUFFER_BIT,
-                                       EGL_RENDERABLE_TYPE, desktop ? EGL_OPENGL_BIT : EGL_OPENGL_ES3_BIT,
-                                       EGL_NONE};
+                                       EGL_RENDERABLE_TYPE,
+                                       desktop ? EGL_OPENGL_BIT : EGL_OPENGL_ES3_BIT, EGL_NONE};
       EGLConfig config = nullptr;
       EGLint n = 0;
       if (!eglChooseConfig(c.display, config_attribs, &config, 1, &n) || n < 1) {
         notes += c.origin + (desktop ? ": no GL config; " : ": no GLES3 config; ");
         continue;
       }
-      const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, desktop ? 4 : 3,
-                                    EGL_CONTEXT_MINOR_VERSION, desktop ? 3 : 2,
+      const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                    desktop ? 4 : 3,
+                                    EGL_CONTEXT_MINOR_VERSION,
+                                    desktop ? 3 : 2,
                                     EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                    EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                                    EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                    EGL_NONE};
       // EGL_CONTEXT_OPENGL_PROFILE_MASK is invalid for GLES: cut the list before it.
       std::vector<EGLint> attribs(ctx_attribs, ctx_attribs + (desktop ? 7 : 4));
       attribs.push_back(EGL_NONE);
@@ -205,7 +220,8 @@ std::unique_ptr<EglContext> EglContext::create(std::string* why_not) {
 EglContext::~EglContext() {
   EGLDisplay d = display_;
   eglBindAPI(api_ == GlApi::DesktopCore ? EGL_OPENGL_API : EGL_OPENGL_ES_API);
-  if (eglGetCurrentContext() == context_) eglMakeCurrent(d, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (eglGetCurrentContext() == context_)
+    eglMakeCurrent(d, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   if (surface_) eglDestroySurface(d, surface_);
   eglDestroyContext(d, context_);
   release_display(d);

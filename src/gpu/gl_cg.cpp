@@ -42,13 +42,13 @@ void GlCg::start(const Vector& r0) {
 void GlCg::iterate(int count) {
   for (int it = 0; it < count; ++it) {
     const int nxt = 1 - cur_;
-    spmv_.multiply(p_[cur_], q_);                 // q = A p
-    reduction_.dot(p_[cur_], q_, pq_);            // p.q
-    runner_.use("cg_alpha.frag.glsl");            // alpha = r.z / p.q
+    spmv_.multiply(p_[cur_], q_);       // q = A p
+    reduction_.dot(p_[cur_], q_, pq_);  // p.q
+    runner_.use("cg_alpha.frag.glsl");  // alpha = r.z / p.q
     runner_.texture("u_rz", rz_[cur_]);
     runner_.texture("u_pq", pq_);
     runner_.draw(alpha_);
-    runner_.use("cg_update_xrz.frag.glsl");       // x, r, z
+    runner_.use("cg_update_xrz.frag.glsl");  // x, r, z
     runner_.texture("u_x", x_[cur_]);
     runner_.texture("u_r", r_[cur_]);
     runner_.texture("u_p", p_[cur_]);
@@ -57,12 +57,12 @@ void GlCg::iterate(int count) {
     runner_.texture("u_minv", minv_);
     runner_.texture("u_alpha", alpha_);
     runner_.draw({&x_[nxt], &r_[nxt], &z_});
-    reduction_.dot(r_[nxt], z_, rz_[nxt]);        // (r.z, r.r) new
-    runner_.use("cg_beta.frag.glsl");             // beta = new / old
+    reduction_.dot(r_[nxt], z_, rz_[nxt]);  // (r.z, r.r) new
+    runner_.use("cg_beta.frag.glsl");       // beta = new / old
     runner_.texture("u_rz_new", rz_[nxt]);
     runner_.texture("u_rz_old", rz_[cur_]);
     runner_.draw(beta_);
-    runner_.use("cg_update_p.frag.glsl");         // p = z + beta p
+    runner_.use("cg_update_p.frag.glsl");  // p = z + beta p
     runner_.texture("u_z", z_);
     runner_.texture("u_p", p_[cur_]);
     runner_.texture("u_beta", beta_);

@@ -84,7 +84,8 @@ void PassRunner::draw(std::initializer_list<const Texture*> targets) {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
     int i = 0;
     for (const Texture* t : targets)
-      glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + i++, GL_TEXTURE_2D, t->id(), 0);
+      glFramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + i++, GL_TEXTURE_2D,
+                             t->id(), 0);
     if (glCheckFramebufferStatus(GL_DRAW_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw std::runtime_error("gl pass: multi-target framebuffer incomplete");
   }

@@ -19,13 +19,20 @@ struct FormatInfo {
 
 FormatInfo format_info(GLenum internal) {
   switch (internal) {
-    case GL_R32F: return {GL_RED, GL_FLOAT, 1};
-    case GL_RG32F: return {GL_RG, GL_FLOAT, 2};
-    case GL_RGBA32F: return {GL_RGBA, GL_FLOAT, 4};
-    case GL_R32I: return {GL_RED_INTEGER, GL_INT, 1};
-    case GL_RG32I: return {GL_RG_INTEGER, GL_INT, 2};
-    case GL_RGBA32I: return {GL_RGBA_INTEGER, GL_INT, 4};
-    default: throw std::runtime_error("gl texture: unsupported internal format");
+    case GL_R32F:
+      return {GL_RED, GL_FLOAT, 1};
+    case GL_RG32F:
+      return {GL_RG, GL_FLOAT, 2};
+    case GL_RGBA32F:
+      return {GL_RGBA, GL_FLOAT, 4};
+    case GL_R32I:
+      return {GL_RED_INTEGER, GL_INT, 1};
+    case GL_RG32I:
+      return {GL_RG_INTEGER, GL_INT, 2};
+    case GL_RGBA32I:
+      return {GL_RGBA_INTEGER, GL_INT, 4};
+    default:
+      throw std::runtime_error("gl texture: unsupported internal format");
   }
 }
 
@@ -97,7 +104,8 @@ unsigned Texture::framebuffer() const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, id_, 0);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw std::runtime_error("gl texture: float render target incomplete (no color_buffer_float?)");
+      throw std::runtime_error(
+          "gl texture: float render target incomplete (no color_buffer_float?)");
   }
   return fbo_;
 }

@@ -39,9 +39,12 @@ std::int32_t float_bits(float f) {
 
 std::string layout_name(SpmvLayout layout) {
   switch (layout) {
-    case SpmvLayout::MethodA: return "method_a";
-    case SpmvLayout::MethodB: return "method_b";
-    case SpmvLayout::RowLoop: return "row_loop";
+    case SpmvLayout::MethodA:
+      return "method_a";
+    case SpmvLayout::MethodB:
+      return "method_b";
+    case SpmvLayout::RowLoop:
+      return "row_loop";
   }
   return "?";
 }

@@ -23,7 +23,6 @@ std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
   return log.c_str();  // drop the trailing NUL
 }
 
-
 std::string read_file(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;

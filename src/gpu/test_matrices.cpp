@@ -31,7 +31,8 @@ SparseMatrix build(int n, const std::vector<Triplet>& t) {
 
 void append(std::vector<Triplet>& t, const SparseMatrix& a) {
   for (int i = 0; i < a.outerSize(); ++i)
-    for (SparseMatrix::InnerIterator it(a, i); it; ++it) t.emplace_back(i, int(it.col()), it.value());
+    for (SparseMatrix::InnerIterator it(a, i); it; ++it)
+      t.emplace_back(i, int(it.col()), it.value());
 }
 
 }  // namespace

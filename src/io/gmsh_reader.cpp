@@ -1,6 +1,6 @@
 // Gmsh .msh reader: format 1 ($NOD/$ELM), 2.x and 4.1 ($Nodes/$Elements, entity blocks in
-// 4.1), ASCII and binary. Only tetrahedra (element type 4) are kept (SPEC 3); node tags may be
-// non-contiguous and are mapped to 0-based indices in file order.
+// 4.1), ASCII and binary. Only tetrahedra (element type 4) are kept (docs/SCENE.md "Meshes"); node
+// tags may be non-contiguous and are mapped to 0-based indices in file order.
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 
@@ -279,8 +279,8 @@ class GmshReader {
 
   // Gmsh 4.1 $Nodes / $Elements header: numBlocks numItems minTag maxTag (four size_t in
   // binary). `min_bytes_per_item` bounds the ASCII item count by the file size.
-  void read_v4_section_header(const std::string& what, int min_bytes_per_item,
-                              long long& blocks, long long& total) {
+  void read_v4_section_header(const std::string& what, int min_bytes_per_item, long long& blocks,
+                              long long& total) {
     if (binary_) {
       c_.skip_past_newline();
       const std::string header = what + " section header";

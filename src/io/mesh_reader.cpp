@@ -1,4 +1,4 @@
-// read_mesh: dispatch on the file extension, then the SPEC 3 validation.
+// read_mesh: dispatch on the file extension, then the docs/SCENE.md "Meshes" validation.
 #include "soft_tissue_cutting/io/mesh_reader.hpp"
 
 #include "format_readers.hpp"

@@ -1,4 +1,4 @@
-// The mesh checks of SPEC 3, shared by every reader and by generated scene meshes.
+// The mesh checks of docs/SCENE.md "Meshes", shared by every reader and by generated scene meshes.
 #include "soft_tissue_cutting/io/mesh_reader.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 
@@ -61,7 +61,8 @@ void validate_tet_mesh(TetMesh& mesh, const std::string& path, std::vector<std::
                  " is in the minority): inconsistent or tangled mesh");
   }
   if (negative > 0) {
-    // Every tet inverted: a consistent mesh written with the other convention (SPEC 3).
+    // Every tet inverted: a consistent mesh written with the other convention (docs/SCENE.md
+    // "Meshes").
     for (Tet& tet : mesh.tets) std::swap(tet[2], tet[3]);
     if (warnings)
       warnings->push_back(path + ": all " + std::to_string(negative) +

@@ -1,5 +1,6 @@
 // Closed triangle surfaces: Wavefront OBJ, STL (ASCII and binary), OFF. Polygons are split
-// into triangle fans; tetrahedralize_surface then checks closure and runs TetGen (SPEC 3).
+// into triangle fans; tetrahedralize_surface then checks closure and runs TetGen (docs/SCENE.md
+// "Meshes").
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 

@@ -1,8 +1,8 @@
-// Closed surface -> tetrahedral mesh with the TetGen library (SPEC 3). The surface is checked
-// first (every edge in exactly two triangles) so an open surface gets a clear message instead
-// of whatever TetGen makes of it. TetGen itself runs in a forked child (isolated_child.hpp):
-// TetGen 1.5 can abort or double-free on some bad surfaces, and that must become one error
-// line naming the file, not a dead process.
+// Closed surface -> tetrahedral mesh with the TetGen library (docs/SCENE.md "Meshes"). The surface
+// is checked first (every edge in exactly two triangles) so an open surface gets a clear message
+// instead of whatever TetGen makes of it. TetGen itself runs in a forked child
+// (isolated_child.hpp): TetGen 1.5 can abort or double-free on some bad surfaces, and that must
+// become one error line naming the file, not a dead process.
 #include "format_readers.hpp"
 #include "isolated_child.hpp"
 #include "text_cursor.hpp"

@@ -1,5 +1,5 @@
-// TetGen .node + .ele reader (SPEC 3: named by the .node; 0- or 1-based as the first point
-// index in .node says). Attributes and boundary markers are read past and ignored.
+// TetGen .node + .ele reader (docs/SCENE.md "Meshes": named by the .node; 0- or 1-based as the
+// first point index in .node says). Attributes and boundary markers are read past and ignored.
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 

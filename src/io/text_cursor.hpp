@@ -1,5 +1,6 @@
 // A bounds-checked reader over a whole file held in memory, for the mesh readers: tokens,
-// lines and raw binary blocks, tracking the line number for messages (SPEC 3: name the line).
+// lines and raw binary blocks, tracking the line number for messages (docs/SCENE.md "Meshes": name
+// the line).
 #pragma once
 
 #include "soft_tissue_cutting/io/mesh_error.hpp"

@@ -1,5 +1,6 @@
 // VTK legacy UNSTRUCTURED_GRID reader, ASCII and BINARY (big-endian), classic CELLS layout
-// and the 5.1 OFFSETS/CONNECTIVITY layout. Only VTK_TETRA (10) cells are kept (SPEC 3).
+// and the 5.1 OFFSETS/CONNECTIVITY layout. Only VTK_TETRA (10) cells are kept (docs/SCENE.md
+// "Meshes").
 #include "format_readers.hpp"
 #include "text_cursor.hpp"
 

@@ -1,5 +1,6 @@
-// SPEC 4 output file: VTK legacy ASCII UNSTRUCTURED_GRID with rest positions, tets (type 10),
-// the displacement of every node and the operation-region flag of every tet.
+// The output file of docs/SCENE.md "Offline run": VTK legacy ASCII UNSTRUCTURED_GRID with rest
+// positions, tets (type 10), the displacement of every node and the operation-region flag of every
+// tet.
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
 
 #include <cstdio>

@@ -1,6 +1,6 @@
 // VTK XML UnstructuredGrid (.vtu) reader, ascii DataArrays only: Points, and Cells'
-// connectivity/offsets/types. Only VTK_TETRA (10) cells are kept (SPEC 3). The XML subset VTK
-// writes is scanned directly (elements, attributes, comments); binary/appended data and
+// connectivity/offsets/types. Only VTK_TETRA (10) cells are kept (docs/SCENE.md "Meshes"). The XML
+// subset VTK writes is scanned directly (elements, attributes, comments); binary/appended data and
 // compressed files are refused with a clear message.
 #include "format_readers.hpp"
 #include "text_cursor.hpp"

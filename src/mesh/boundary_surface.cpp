@@ -49,8 +49,8 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
     if (j - i == 1) {
       const Tet& tet = mesh.tets[first.tet];
       const auto& lf = kTetFaces[first.face];
-      surface.triangles.push_back({Tri{tet[lf[0]], tet[lf[1]], tet[lf[2]]}, first.tet,
-                                   first.face, mesh.is_cut_face(first.tet, first.face)});
+      surface.triangles.push_back({Tri{tet[lf[0]], tet[lf[1]], tet[lf[2]]}, first.tet, first.face,
+                                   mesh.is_cut_face(first.tet, first.face)});
     } else if (j - i > 2) {
       ++surface.non_manifold_faces;
     } else {
@@ -75,7 +75,8 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
 std::vector<int> boundary_nodes(const BoundarySurface& surface) {
   std::vector<int> nodes;
   nodes.reserve(surface.triangles.size() * 3);
-  for (const auto& tri : surface.triangles) nodes.insert(nodes.end(), tri.nodes.begin(), tri.nodes.end());
+  for (const auto& tri : surface.triangles)
+    nodes.insert(nodes.end(), tri.nodes.begin(), tri.nodes.end());
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
   return nodes;

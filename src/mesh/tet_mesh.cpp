@@ -13,7 +13,8 @@ double tet_volume(const TetMesh& mesh, int tet) {
 
 double total_volume(const TetMesh& mesh) {
   // Kahan-free pairwise would be overkill: volumes are summed in tet order, and the 1e-9
-  // volume invariant (SPEC 6) is far above double round-off for meshes of this size.
+  // volume invariant (docs/SCENE.md "Cut invariants") is far above double round-off for meshes of
+  // this size.
   double v = 0;
   for (int t = 0; t < mesh.num_tets(); ++t) v += tet_volume(mesh, t);
   return v;

@@ -26,12 +26,19 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
     for (int n : mesh.tets[static_cast<size_t>(t)]) used[static_cast<size_t>(n)] |= op ? 1 : 2;
   }
   std::vector<std::uint8_t> on_boundary(static_cast<size_t>(mesh.num_nodes()), 0);
-  for (int n : boundary_nodes(extract_boundary_surface(mesh))) on_boundary[static_cast<size_t>(n)] = 1;
+  for (int n : boundary_nodes(extract_boundary_surface(mesh)))
+    on_boundary[static_cast<size_t>(n)] = 1;
   p.node_set.assign(static_cast<size_t>(mesh.num_nodes()), NodeSet::kUnused);
   for (int n = 0; n < mesh.num_nodes(); ++n) {
     switch (used[static_cast<size_t>(n)]) {
-      case 1: p.node_set[n] = NodeSet::kOperation; p.operation.push_back(n); break;
-      case 3: p.node_set[n] = NodeSet::kInterface; p.interface.push_back(n); break;
+      case 1:
+        p.node_set[n] = NodeSet::kOperation;
+        p.operation.push_back(n);
+        break;
+      case 3:
+        p.node_set[n] = NodeSet::kInterface;
+        p.interface.push_back(n);
+        break;
       case 2:
         if (on_boundary[static_cast<size_t>(n)]) {
           p.node_set[n] = NodeSet::kSurface;
@@ -41,10 +48,42 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
           p.interior.push_back(n);
         }
         break;
-      default: break;
+      default:
+        break;
     }
   }
   return p;
+}
+
+bool update_partition_for_operation_change(const TetMesh& mesh,
+                                           const std::vector<int>& changed_tets, Partition& p) {
+  const size_t old_tets = p.operation_tet.size();
+  for (int t : changed_tets)
+    if (t >= 0 && static_cast<size_t>(t) < old_tets && !p.operation_tet[static_cast<size_t>(t)])
+      return false;  // a part-2 tet was changed
+  p.operation_tet.resize(static_cast<size_t>(mesh.num_tets()), 1);
+  for (int t = static_cast<int>(old_tets); t < mesh.num_tets(); ++t) p.operation_tets.push_back(t);
+  // Nodes of part 2 (I, S, Q) keep their sets: part 2 did not change. Which nodes part 1 uses
+  // now decides O (and whether every interface node is still shared).
+  std::vector<std::uint8_t> used(static_cast<size_t>(mesh.num_nodes()), 0);
+  for (int t : p.operation_tets)
+    for (int n : mesh.tets[static_cast<size_t>(t)]) used[static_cast<size_t>(n)] = 1;
+  for (int n : p.interface)
+    if (!used[static_cast<size_t>(n)]) return false;
+  p.node_set.resize(static_cast<size_t>(mesh.num_nodes()), NodeSet::kUnused);
+  p.operation.clear();
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    NodeSet& set = p.node_set[static_cast<size_t>(n)];
+    if (set == NodeSet::kInterface) continue;
+    if (used[static_cast<size_t>(n)]) {
+      if (set == NodeSet::kSurface || set == NodeSet::kInterior) return false;
+      set = NodeSet::kOperation;
+      p.operation.push_back(n);
+    } else if (set == NodeSet::kOperation) {
+      set = NodeSet::kUnused;  // every tet of it was replaced (its copies took over)
+    }
+  }
+  return true;
 }
 
 }  // namespace stc

@@ -27,18 +27,29 @@ geometry_msgs::Pose to_pose_msg(const BladePose& b) {
   return p;
 }
 
-bool is_finite_pose(const geometry_msgs::Pose& p) {
+namespace {
+std::string quaternion_problem(double x, double y, double z, double w) {
+  return x * x + y * y + z * z + w * w > 1e-12 ? "" : "zero quaternion";
+}
+}  // namespace
+
+std::string pose_problem(const geometry_msgs::Pose& p) {
   const double v[7] = {p.position.x,    p.position.y,    p.position.z,   p.orientation.x,
                        p.orientation.y, p.orientation.z, p.orientation.w};
   for (double x : v)
-    if (!std::isfinite(x)) return false;
-  const double n2 = v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6];
-  return n2 > 1e-12;
+    if (!std::isfinite(x)) return "not finite (NaN/Inf)";
+  return quaternion_problem(v[3], v[4], v[5], v[6]);
+}
+
+std::string pose_problem(const BladePose& b) {
+  if (!b.position.allFinite() || !b.orientation.coeffs().allFinite()) return "not finite (NaN/Inf)";
+  const Eigen::Vector4d q = b.orientation.coeffs();
+  return quaternion_problem(q[0], q[1], q[2], q[3]);
 }
 
 soft_tissue_cutting::SimStats to_stats_msg(const StepStats& s, const ModelCounts& c,
-                                           const std::string& backend,
-                                           const std::string& renderer, double rate_hz) {
+                                           const std::string& backend, const std::string& renderer,
+                                           double rate_hz) {
   soft_tissue_cutting::SimStats m;
   m.step = s.step;
   m.backend = backend;

@@ -1,33 +1,69 @@
 #include "soft_tissue_cutting/ros/pose_input.hpp"
 
+#include "soft_tissue_cutting/ros/conversions.hpp"
+
 #include <cstdio>
 
 namespace stc {
 namespace ros_io {
 
-bool PoseInput::offer(const BladePose& pose, std::string* why) {
-  const Eigen::Vector4d q = pose.orientation.coeffs();
-  if (!pose.position.allFinite() || !q.allFinite() || q.squaredNorm() < 1e-12) {
-    if (why) *why = "not finite (NaN/Inf) or zero quaternion";
-    return false;
-  }
+double distance_to_box(const Box& box, const Vec3& p) {
+  const Vec3 outside = (box.min - p).cwiseMax(p - box.max).cwiseMax(0.0);
+  return outside.norm();
+}
+
+PoseDecision PoseInput::offer(const BladePose& pose) {
+  PoseDecision d;
+  d.why = pose_problem(pose);
+  if (!d.why.empty()) return d;  // not a jump: does not count towards re-arming
   std::lock_guard<std::mutex> lock(mutex_);
-  if (last_) {
-    const double jump = (pose.position - last_->position).norm();
-    if (jump > max_jump_) {
-      if (why) {
-        char buf[160];
-        std::snprintf(buf, sizeof buf,
-                      "jump of %.4g m from the last accepted pose exceeds ~max_pose_jump = %.4g m",
-                      jump, max_jump_);
-        *why = buf;
-      }
-      return false;
-    }
+  if (!last_) return offer_first_locked(pose, PoseVerdict::kAccepted);
+  const double jump = (pose.position - last_->position).norm();
+  if (jump <= settings_.max_jump) {
+    consecutive_jumps_ = 0;
+    last_ = pose;
+    last_->orientation.normalize();
+    d.verdict = PoseVerdict::kAccepted;
+    return d;
   }
+  if (++consecutive_jumps_ >= settings_.rearm_after) {
+    d = offer_first_locked(pose, PoseVerdict::kRearmed);
+    if (d.accepted()) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "re-armed on the newest pose after %d consecutive jumps over "
+                    "~max_pose_jump = %.4g m",
+                    settings_.rearm_after, settings_.max_jump);
+      d.why = buf;
+      return d;
+    }
+    return d;  // the newest pose is far from the tissue too: keep the last accepted one
+  }
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "jump of %.4g m from the last accepted pose exceeds ~max_pose_jump = %.4g m", jump,
+                settings_.max_jump);
+  d.why = buf;
+  return d;
+}
+
+PoseDecision PoseInput::offer_first_locked(const BladePose& pose, PoseVerdict on_success) {
+  PoseDecision d;
+  const double off = distance_to_box(settings_.tissue_box, pose.position);
+  if (off > settings_.max_jump) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "first pose is %.4g m from the tissue's bounding box (more than "
+                  "~max_pose_jump = %.4g m)",
+                  off, settings_.max_jump);
+    d.why = buf;
+    return d;
+  }
+  consecutive_jumps_ = 0;
   last_ = pose;
   last_->orientation.normalize();
-  return true;
+  d.verdict = on_success;
+  return d;
 }
 
 std::optional<BladePose> PoseInput::latest() const {
@@ -38,6 +74,7 @@ std::optional<BladePose> PoseInput::latest() const {
 void PoseInput::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   last_.reset();
+  consecutive_jumps_ = 0;
 }
 
 }  // namespace ros_io

@@ -1,4 +1,4 @@
-// tissue_node: the ROS 1 face of the simulation (SPEC section 5). See tissue_node.hpp.
+// tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). See tissue_node.hpp.
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
 #include <ros/ros.h>
@@ -9,6 +9,8 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "tissue");
   ros::NodeHandle nh, pnh("~");
   stc::ros_io::NodeParams params;
+  stc::Scene scene;
+  stc::SimulationOptions options;
   std::unique_ptr<stc::Simulation> sim;
   try {
     params = stc::ros_io::read_params(pnh);
@@ -17,15 +19,17 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    stc::SimulationOptions options;
     options.backend = params.backend;
-    sim = std::make_unique<stc::Simulation>(stc::ros_io::load_scene_param(params.scene), options);
+    scene = stc::ros_io::load_scene_param(params.scene);
+    sim = std::make_unique<stc::Simulation>(scene, options);
   } catch (const std::exception& e) {
     ROS_FATAL("tissue_node: cannot load scene '%s': %s", params.scene.c_str(), e.what());
     return 1;
   }
-  stc::ros_io::TissueNode node(nh, pnh, params, std::move(sim));
-  ros::AsyncSpinner spinner(2);  // services never stall the pose callback, nor the loop
+  stc::ros_io::TissueNode node(nh, pnh, params, std::move(scene), options, std::move(sim));
+  // Six callback threads: up to three ~cut calls wait for the loop while the pose callback and
+  // the other services go on.
+  ros::AsyncSpinner spinner(6);
   spinner.start();
   node.start();
   ros::waitForShutdown();

@@ -1,6 +1,6 @@
-// SPEC 3 scene files: strict parsing into a local Scene that is returned only when everything
-// checked out (nothing half-loaded). Order matters: the mesh is loaded and scaled first,
-// because selectors, regions and poses are in the scaled scene frame.
+// Scene files (docs/SCENE.md "Scene file"): strict parsing into a local Scene that is returned only
+// when everything checked out (nothing half-loaded). Order matters: the mesh is loaded and scaled
+// first, because selectors, regions and poses are in the scaled scene frame.
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 
 #include "soft_tissue_cutting/generators/thigh.hpp"

@@ -27,10 +27,14 @@ std::vector<int> NodeSelector::select(const TetMesh& mesh) const {
 
 bool OperationRegion::contains(const Vec3& centroid) const {
   switch (kind) {
-    case Kind::kAll: return true;
-    case Kind::kNone: return false;
-    case Kind::kSphere: return sphere.contains(centroid);
-    case Kind::kBox: return box.contains(centroid);
+    case Kind::kAll:
+      return true;
+    case Kind::kNone:
+      return false;
+    case Kind::kSphere:
+      return sphere.contains(centroid);
+    case Kind::kBox:
+      return box.contains(centroid);
   }
   return false;
 }

@@ -1,5 +1,5 @@
 // Strict typed access to yaml-cpp nodes for the scene loader: every problem becomes a
-// SceneError "file:line: key.path: problem" (SPEC 3). Private to src/scene.
+// SceneError "file:line: key.path: problem" (docs/SCENE.md "Scene file"). Private to src/scene.
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"

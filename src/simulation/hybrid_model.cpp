@@ -34,17 +34,13 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
   elements_ = ElementStiffnessCache(mesh_, scene.material);
   timings_["element_stiffness"] = ms_since(t0);
 
-  // K0, g0 (METHOD 3). Loads on interface nodes stay with part 1 (they enter f_I below), so
-  // only f_N reaches the condensation.
+  // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
+  // below), so only f_N reaches the condensation.
   condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
   timings_["condensation_assembly"] = condensed_.assembly_ms;
   timings_["condensation_factor"] = condensed_.factor_ms;
   timings_["condensation_solve"] = condensed_.solve_ms;
   timings_["condensation_products"] = condensed_.product_ms;
-
-  t0 = Clock::now();
-  recovery_ = make_surface_recovery(condensed_, mesh_.num_nodes(), partition_.surface, fixed_);
-  timings_["recovery_operator"] = ms_since(t0);
 
   u_ = Vector::Zero(3 * mesh_.num_nodes());
   t0 = Clock::now();
@@ -69,25 +65,39 @@ void HybridModel::rebuild_hybrid_system() {
   for (int k = 0; k < idofs.rows(); ++k)
     interface_row_[static_cast<size_t>(k)] = dofs_.row_of[static_cast<size_t>(idofs.global_of[k])];
 
-  // K1 from part-1 tets, plus K0 on the interface block (eq. 17).
+  // K1 from part-1 tets, plus K0 on the interface block (eq. 17). The free interface DOFs are
+  // the first rows, in the condensation's order (I is listed first and never changes), so
+  // K0 enters as one sparse matrix kept from the first assembly: a cut re-assembles part 1
+  // only and adds K0 (a merge), never re-sorting the dense block's |3I|^2 triplets.
+  for (int k = 0; k < idofs.rows(); ++k)
+    if (interface_row_[static_cast<size_t>(k)] != k)
+      throw std::logic_error("HybridModel: the interface DOFs are not the leading rows");
+  const int ni = idofs.rows(), n = dofs_.rows();
+  if (k0_padded_.rows() != ni) k0_padded_ = condensed_.K0.sparseView(0.0, 0.0);
   std::vector<Triplet> t;
-  t.reserve(partition_.operation_tets.size() * 144 +
-            static_cast<size_t>(condensed_.K0.size()));
+  t.reserve(partition_.operation_tets.size() * 144);
   add_element_triplets(mesh_, elements_, partition_.operation_tets, dofs_.row_of, dofs_.row_of, t);
-  for (int j = 0; j < idofs.rows(); ++j)
-    for (int i = 0; i < idofs.rows(); ++i)
-      t.emplace_back(interface_row_[static_cast<size_t>(i)], interface_row_[static_cast<size_t>(j)],
-                     condensed_.K0(i, j));
-  a_ = SparseMatrix(dofs_.rows(), dofs_.rows());
-  a_.setFromTriplets(t.begin(), t.end());
+  SparseMatrix k1(n, n);
+  k1.setFromTriplets(t.begin(), t.end());
+  SparseMatrix k0 = k0_padded_;
+  k0.conservativeResize(n, n);
+  a_ = k1 + k0;
 
   // Right-hand side: f_O, f_I - g0.
   b_ = gather(loads(), dofs_);
-  for (int k = 0; k < idofs.rows(); ++k) b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
+  for (int k = 0; k < idofs.rows(); ++k)
+    b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
   solver_->set_matrix(a_);
+  system_changed_ = true;
 }
 
 CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
+  // Same system, same imposed displacements: the last solution still solves it exactly, so
+  // an idle step costs nothing (docs/DESIGN.md, per-step cost).
+  if (!system_changed_ && imposed == last_imposed_) {
+    last_.iterations = 0;
+    return last_;
+  }
   Vector x = gather(u_, dofs_);  // warm start: the last step's solution
   std::vector<std::uint8_t> constrained;
   if (!imposed.empty()) constrained.assign(static_cast<size_t>(dofs_.rows()), 0);
@@ -109,23 +119,37 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
   if (dofs_.rows() > 0) {
     last_ = solver_->solve(b_, x, constrained, settings_);
   } else {
-    last_ = CgResult{0, 0.0, true};  // `none`: nothing to solve, u_S = c_S
+    last_ = CgResult{};  // `none`: nothing to solve, u_S = c_S
+    last_.converged = true;
   }
   scatter(x, dofs_, u_);
-  recover_surface();
+  // u_S and u_Q follow u_I alone: recovered on demand (displacement()), and only if u_I moved.
+  Vector u_i = gather(u_, condensed_.interface_dofs);
+  if (u_i != recovered_from_) condensed_stale_ = true;
+  last_imposed_ = imposed;
+  system_changed_ = false;
   return last_;
 }
 
-void HybridModel::recover_surface() {
-  // u_S = c_S + R u_I (METHOD 4).
-  const Vector u_i = gather(u_, condensed_.interface_dofs);
-  scatter(recovery_.recover(u_i), recovery_.surface_dofs, u_);
+const Vector& HybridModel::displacement() const {
+  if (!condensed_stale_) return u_;
+  // u_N = K2_NN^-1 (f_N - K2_NI u_I) (docs/DESIGN.md eq. (13)) through the kept factor: S and Q at
+  // once, exact to the factorization's rounding, no dense 3|S| x 3|I| operator in memory.
+  recovered_from_ = gather(u_, condensed_.interface_dofs);
+  if (condensed_.condensed_dofs.rows() > 0)
+    scatter(recover_condensed(condensed_, recovered_from_, condensed_scale_),
+            condensed_.condensed_dofs, u_);
+  condensed_stale_ = false;
+  ++recoveries_;
+  return u_;
 }
 
-void HybridModel::recover_interior() {
-  if (condensed_.condensed_dofs.rows() == 0) return;
-  const Vector u_i = gather(u_, condensed_.interface_dofs);
-  scatter(recover_condensed(condensed_, u_i, condensed_scale_), condensed_.condensed_dofs, u_);
+void HybridModel::recover_interior() { displacement(); }
+
+void HybridModel::reset_displacement() {
+  u_.setZero();
+  system_changed_ = true;  // the next solve starts cold
+  condensed_stale_ = true;
 }
 
 Vec3 HybridModel::reaction_force(const std::vector<int>& nodes) const {
@@ -149,8 +173,9 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   const int old_nodes = static_cast<int>(u_.size() / 3);
   const int n = mesh_.num_nodes();
   if (n - old_nodes != static_cast<int>(new_nodes.size()))
-    throw std::invalid_argument("HybridModel::update_operation_part: new_nodes does not match "
-                                "the nodes appended to the mesh");
+    throw std::invalid_argument(
+        "HybridModel::update_operation_part: new_nodes does not match "
+        "the nodes appended to the mesh");
   // New nodes: displacement interpolated from their parents (cut_result.hpp), unloaded.
   u_.conservativeResize(3 * n);
   point_loads_.conservativeResize(3 * n);
@@ -162,8 +187,10 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     if (nn.a < 0 || nn.a >= node || (split && (nn.b < 0 || nn.b >= node)))
       throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
     if (split) {
-      u_.segment<3>(3 * node) = (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
-      fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
+      u_.segment<3>(3 * node) =
+          (1 - nn.t) * u_.segment<3>(3 * nn.a) + nn.t * u_.segment<3>(3 * nn.b);
+      fixed_[static_cast<size_t>(node)] =
+          fixed_[static_cast<size_t>(nn.a)] && fixed_[static_cast<size_t>(nn.b)];
     } else {
       u_.segment<3>(3 * node) = u_.segment<3>(3 * nn.a);
       fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)];
@@ -172,15 +199,13 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   }
   // Only the changed element matrices are recomputed.
   elements_.update(mesh_, changed_tets);
-  std::vector<std::uint8_t> operation_tet = partition_.operation_tet;
-  operation_tet.resize(static_cast<size_t>(mesh_.num_tets()), 1);
-  for (int t : changed_tets) operation_tet[static_cast<size_t>(t)] = 1;
-  Partition p = partition_from_labels(mesh_, std::move(operation_tet));
-  // The condensed part must be untouched: same I, S, Q and part-2 tets.
-  if (p.interface != partition_.interface || p.surface != partition_.surface ||
-      p.interior != partition_.interior || p.condensed_tets != partition_.condensed_tets)
-    throw std::logic_error("HybridModel::update_operation_part: the change reached the "
-                           "condensed (non-operation) part");
+  // Only part 1 changed: the partition is updated from the part-1 tets alone. The condensed
+  // part must be untouched: same I, S, Q and part-2 tets.
+  Partition p = partition_;
+  if (!update_partition_for_operation_change(mesh_, changed_tets, p))
+    throw std::logic_error(
+        "HybridModel::update_operation_part: the change reached the "
+        "condensed (non-operation) part");
   partition_ = std::move(p);
   rebuild_hybrid_system();
 }
@@ -189,9 +214,10 @@ void HybridModel::set_young_modulus(double young_modulus) {
   if (!(young_modulus > 0)) throw std::invalid_argument("young_modulus must be > 0");
   const double s = young_modulus / elements_.material().young_modulus;
   elements_.set_young_modulus(young_modulus);
-  condensed_.K0 *= s;        // K2 scales with E
-  recovery_.c_S /= s;        // [K2_NN^-1 f_N]_S scales with 1/E; R and g0 are ratios
-  condensed_scale_ *= s;
+  condensed_.K0 *= s;  // K2 scales with E
+  k0_padded_ *= s;
+  condensed_scale_ *= s;  // u_N recovery: K2_NN^-1 f_N scales with 1/E; g0 is a ratio
+  condensed_stale_ = true;
   rebuild_hybrid_system();
 }
 
@@ -199,6 +225,7 @@ void HybridModel::set_solver(std::unique_ptr<LinearSolver> solver) {
   if (!solver) throw std::invalid_argument("HybridModel: no linear solver");
   solver_ = std::move(solver);
   solver_->set_matrix(a_);
+  system_changed_ = true;
 }
 
 HybridModelCounts HybridModel::counts() const {

@@ -3,13 +3,17 @@
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
+#include "soft_tissue_cutting/cutting/blade_path.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/rest_mapping.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
+#include "soft_tissue_cutting/simulation/step_times.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
@@ -22,11 +26,25 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// Median edge length of the operation part's tets (0 if it has none).
+double median_operation_edge(const TetMesh& mesh, const std::vector<std::uint8_t>& operation) {
+  std::vector<double> edges;
+  for (size_t t = 0; t < mesh.tets.size(); ++t) {
+    if (t >= operation.size() || !operation[t]) continue;
+    const Tet& k = mesh.tets[t];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) edges.push_back((mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
+  }
+  if (edges.empty()) return 0;
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+  return edges[edges.size() / 2];
+}
+
 }  // namespace
 
 struct Simulation::Impl {
-  Scene initial;   // as loaded: reset() returns here
-  Scene scene;     // live parameters (cut pressure, E)
+  Scene initial;  // as loaded: reset() returns here
+  Scene scene;    // live parameters (cut pressure, E)
   SimulationOptions options;
   std::string backend_note, renderer, backend = "cpu";
   std::unique_ptr<HybridModel> model;
@@ -34,6 +52,7 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
+  OperationSurface boundary;           // the boundary after cuts from part 1 alone
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -51,10 +70,20 @@ struct Simulation::Impl {
   std::uint64_t steps = 0, surface_version = 0;
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
+  long solver_fallbacks = 0;
   StepStats last;
+  StepTimes step_times;  // every step() since start(), by kind (stats JSON step_ms)
+
+  std::string requested_backend() const {
+    return options.backend.empty() ? scene.solver.backend : options.backend;
+  }
+
+  // ~cut paths are resampled at this spacing (docs/DESIGN.md (cutting)): the median edge of
+  // the initial operation part, so one sweep per element size whatever the caller's sampling.
+  double cut_spacing = 0;
 
   std::unique_ptr<LinearSolver> make_solver() {
-    const std::string wanted = options.backend.empty() ? scene.solver.backend : options.backend;
+    const std::string wanted = requested_backend();
     backend = "cpu";
     renderer.clear();
     if (wanted == "gl") {
@@ -81,6 +110,7 @@ struct Simulation::Impl {
     std::vector<std::uint8_t> locked(static_cast<size_t>(model->mesh().num_nodes()), 0);
     for (int i : p.interface) locked[static_cast<size_t>(i)] = 1;
     cut_state = make_cut_state(model->mesh_for_cutting(), locked, p.operation_tet);
+    cut_spacing = median_operation_edge(scene.mesh, p.operation_tet);
     anchored = model->fixed_nodes();
     for (int i : p.interface) anchored[static_cast<size_t>(i)] = 1;
     held.clear();
@@ -94,9 +124,12 @@ struct Simulation::Impl {
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
+    solver_fallbacks = 0;
     last = StepStats{};
+    step_times.clear();
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
+    boundary.init(model->mesh(), model->partition().operation_tet);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
   }
@@ -111,8 +144,7 @@ struct Simulation::Impl {
     if (!floating.empty())
       throw std::invalid_argument(
           scene.source + ": the mesh has " + std::to_string(floating.size()) +
-          " piece(s) with no fixed node (the first has " +
-          std::to_string(floating[0].tets.size()) +
+          " piece(s) with no fixed node (the first has " + std::to_string(floating[0].tets.size()) +
           " tets): fix at least one node of every piece");
   }
 
@@ -125,6 +157,10 @@ struct Simulation::Impl {
     s.cg_iterations += r.iterations;
     cg_iterations_total += r.iterations;
     s.residual = r.residual;
+    s.solved_by = r.solved_by.empty() ? backend : r.solved_by;
+    s.fallback_reason = r.fallback_reason;
+    s.solver_message = r.message;
+    if (!r.fallback_reason.empty()) ++solver_fallbacks;
     return r.converged;
   }
 
@@ -199,7 +235,9 @@ struct Simulation::Impl {
     for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
     for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
     hold_free_pieces();
-    surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
+    const Partition& p = model->partition();
+    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
+                       p.operation_tet, displacements());
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
@@ -209,11 +247,15 @@ struct Simulation::Impl {
     return true;
   }
 
-  // SPEC 6: a piece severed from everything anchored is kept and held where it is.
+  // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
+  // it is.
   void hold_free_pieces() {
-    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+    // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
+    // (its condensation is nonsingular), and those are anchored.
+    const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
+    for (const MeshPiece& piece : free_pieces(part1, anchored)) {
       for (int n : piece.nodes) {
-        held[n] = model->displacement().segment<3>(3 * n);
+        held[n] = model->operation_displacement().segment<3>(3 * n);
         anchored[static_cast<size_t>(n)] = 1;
       }
       ++free_pieces_held;
@@ -223,8 +265,10 @@ struct Simulation::Impl {
     }
   }
 
+  // O and I current, S as last recovered: the tree's operation triangles (the only ones
+  // contact looks at) are exact, and a step does not wait for the recovery of u_S.
   std::vector<Vec3> displacements() const {
-    const Vector& u = model->displacement();
+    const Vector& u = model->operation_displacement();
     std::vector<Vec3> out(static_cast<size_t>(model->mesh().num_nodes()));
     for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
     return out;
@@ -274,8 +318,8 @@ struct Simulation::Impl {
         surface_tree.refit(model->mesh(), displacements());
         std::optional<BladeEdge> previous;
         if (last_pose) previous = blade_edge(*last_pose, length);
-        imposed =
-            contact.update(surface_tree, model->mesh(), model->displacement(), previous, edge);
+        imposed = contact.update(surface_tree, model->mesh(), model->operation_displacement(),
+                                 previous, edge);
         blade_state = contact.empty() ? BladeState::kFree : BladeState::kPressing;
       }
       s.collision_ms = ms_since(t0) - s.cutting_ms - s.assembly_ms;
@@ -328,37 +372,96 @@ StepStats Simulation::step(const std::optional<BladePose>& blade) {
     throw std::invalid_argument("blade pose is not finite (NaN/Inf or a zero quaternion)");
   std::optional<BladePose> normalized = blade;
   if (normalized) normalized->orientation.normalize();
-  return impl_->step(normalized);
+  const StepStats s = impl_->step(normalized);
+  impl_->step_times.add(s);
+  return s;
 }
 
+const StepTimes& Simulation::step_times() const { return impl_->step_times; }
+
 CutOutcome Simulation::cut_along(const std::vector<BladePose>& poses) {
-  CutOutcome out;
+  PathCut path = begin_path_cut(poses);
+  while (!path.done()) cut_path_slice(path, Clock::time_point::max());
+  CutOutcome out = finish_path_cut(path);
+  if (!path.refusal.empty()) return out;
+  StepStats s;
+  if (!impl_->solve({}, s)) out.message += "; warning: the solver did not converge";
+  ++impl_->surface_version;
+  return out;
+}
+
+PathCut Simulation::begin_path_cut(const std::vector<BladePose>& poses) const {
+  PathCut cut;
   if (poses.size() < 2) {
-    out.message = "need at least two blade poses to sweep a cut";
-    return out;
+    cut.refusal = "need at least two blade poses to sweep a cut";
+    return cut;
   }
   for (size_t i = 0; i < poses.size(); ++i)
     if (!finite_pose(poses[i])) {
-      out.message = "pose " + std::to_string(i) + " is not finite";
-      return out;
+      cut.refusal = "pose " + std::to_string(i) + " is not finite (NaN/Inf) or a zero quaternion";
+      return cut;
     }
-  const int faces_before = impl_->cut_face_count();
-  StepStats s;
-  for (size_t i = 1; i < poses.size(); ++i) impl_->cut(poses[i - 1], poses[i], s);
-  s.converged = impl_->solve({}, s);
-  ++impl_->surface_version;
-  const int faces_after = impl_->cut_face_count();
-  out.tets_split = s.tets_split;
-  out.nodes_added = s.nodes_added;
-  out.cut_faces = faces_after - faces_before;
-  out.success = s.cutting;
-  out.message = s.cutting ? "cut inserted" : "the blade path does not cross the operation part";
-  if (s.reached_interface) out.message += "; stopped at the interface of the condensed part";
-  if (!s.converged) out.message += "; warning: the solver did not converge";
+  cut.poses = resample_blade_path(poses, impl_->scene.scalpel.blade_length, impl_->cut_spacing);
+  cut.faces_before = impl_->cut_face_count();
+  return cut;
+}
+
+void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
+  const double length = impl_->scene.scalpel.blade_length;
+  bool changed = false;
+  do {
+    if (cut.done()) break;
+    const BladePose& from = cut.poses[cut.next - 1];
+    const BladePose& to = cut.poses[cut.next];
+    // Does the blade edge lie in the operation part here? (Tells "already cut" from "missed".)
+    if (!cut.crossed) {
+      const BladeEdge e = blade_edge(from, length);
+      // In the DEFORMED tissue, where the blade is (the cut is carried to rest coordinates).
+      for (const Vec3& x : {e.tip, Vec3(0.5 * (e.tip + e.heel)), e.heel})
+        cut.crossed = cut.crossed || impl_->surface_tree.contains(x);
+    }
+    StepStats s;
+    changed |= impl_->cut(from, to, s);
+    cut.tets_split += s.tets_split;
+    cut.nodes_added += s.nodes_added;
+    cut.reached_interface |= s.reached_interface;
+    ++cut.next;
+  } while (Clock::now() < deadline);
+  if (changed) {
+    cut.changed = true;
+    ++impl_->surface_version;
+  }
+}
+
+CutOutcome Simulation::finish_path_cut(const PathCut& cut) const {
+  CutOutcome out;
+  if (!cut.refusal.empty()) {
+    out.message = cut.refusal;
+    return out;
+  }
+  out.tets_split = cut.tets_split;
+  out.nodes_added = cut.nodes_added;
+  out.cut_faces = impl_->cut_face_count() - cut.faces_before;
+  out.success = cut.changed;
+  if (cut.changed)
+    out.message = "cut inserted";
+  else if (cut.crossed)
+    out.message =
+        "the blade path runs through the operation part only where it is already cut: "
+        "no new cut faces";
+  else if (cut.reached_interface)
+    out.message =
+        "the blade path only reaches the interface of the condensed part, which is not "
+        "cut";
+  else
+    out.message = "the blade path does not cross the operation part";
+  if (cut.changed && cut.reached_interface)
+    out.message += "; stopped at the interface of the condensed part";
   return out;
 }
 
 void Simulation::reset() { impl_->start(); }
+double Simulation::cut_path_spacing() const { return impl_->cut_spacing; }
 void Simulation::set_cutting_enabled(bool enabled) { impl_->cutting_enabled = enabled; }
 bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
@@ -400,6 +503,7 @@ ModelCounts Simulation::counts() const {
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
   c.cg_iterations_total = impl_->cg_iterations_total;
+  c.solver_fallbacks = impl_->solver_fallbacks;
   c.volume_initial = total_volume(impl_->initial.mesh);
   c.volume_final = total_volume(impl_->model->mesh());
   return c;
@@ -409,6 +513,7 @@ const StepStats& Simulation::last_stats() const { return impl_->last; }
 std::string Simulation::backend() const { return impl_->backend; }
 std::string Simulation::renderer() const { return impl_->renderer; }
 std::string Simulation::backend_note() const { return impl_->backend_note; }
+std::string Simulation::backend_requested() const { return impl_->requested_backend(); }
 std::vector<std::uint8_t> Simulation::tet_regions() const {
   return impl_->model->partition().operation_tet;
 }

@@ -1,4 +1,4 @@
-// Preconditioned projected Conjugate Gradient in double precision (METHOD.md section 5 step 5),
+// Preconditioned projected Conjugate Gradient in double precision (docs/DESIGN.md section 6),
 // the CPU backend of solve/linear_solver.hpp.
 //
 // Projection: constrained DOFs keep the value x has on entry. The residual and search
@@ -11,7 +11,7 @@
 // Preconditioners z = M r (r is zero on constrained DOFs, and so is z):
 //   Jacobi:   M = P diag(A)^-1 P.
 //   Cholesky: M = P A^-1 P, A = L L^T factored by CHOLMOD in set_matrix, i.e. only when the
-//             hybrid matrix changes (construction, cuts, E changes; METHOD.md sections 3, 5).
+//             hybrid matrix changes (construction, cuts, E changes; docs/DESIGN.md sections 4, 6).
 //             On the free DOFs M is (A^-1)_ff = S^-1 with S = A_ff - A_fc A_cc^-1 A_cf (block
 //             inverse), so the preconditioned operator is S^-1 A_ff = I + S^-1 A_fc A_cc^-1 A_cf:
 //             the identity plus rank <= #constrained DOFs. CG therefore needs at most
@@ -27,6 +27,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace stc {
@@ -35,6 +36,12 @@ namespace {
 // Relative diagonal shift of the second factorization attempt: far above the rounding of a
 // zero pivot (~1e-16 n), far below anything that would slow the preconditioned CG.
 constexpr double kShift = 1e-9;
+
+std::string format_residual(double r) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", r);
+  return buf;
+}
 
 class CpuCgSolver final : public LinearSolver {
  public:
@@ -61,6 +68,7 @@ class CpuCgSolver final : public LinearSolver {
                  const CgSettings& settings) override {
     const Eigen::Index n = a_.rows();
     CgResult result;
+    result.solved_by = "cpu";
     if (x.size() != n) x = Vector::Zero(n);
     Vector free_mask = Vector::Ones(n);
     if (!constrained.empty())
@@ -90,7 +98,10 @@ class CpuCgSolver final : public LinearSolver {
         result.converged = true;
         return result;
       }
-      if (result.iterations >= settings.max_iterations) return result;
+      if (result.iterations >= settings.max_iterations) {
+        result.message = iteration_cap_message(result, settings);
+        return result;
+      }
       Vector z = precondition(r);
       Vector p = z;
       double rz = r.dot(z);
@@ -117,6 +128,14 @@ class CpuCgSolver final : public LinearSolver {
           !(true_res < result.residual)) {
         result.residual = true_res;
         result.converged = true_res <= settings.tolerance;
+        if (!result.converged)
+          result.message = result.iterations >= settings.max_iterations
+                               ? iteration_cap_message(result, settings)
+                               : "CG stopped gaining at relative residual " +
+                                     format_residual(true_res) + " (tolerance " +
+                                     format_residual(settings.tolerance) +
+                                     "): too ill-conditioned for double precision, or not "
+                                     "positive definite on the free DOFs";
         return result;
       }
     }
@@ -155,6 +174,12 @@ class CpuCgSolver final : public LinearSolver {
 };
 
 }  // namespace
+
+std::string iteration_cap_message(const CgResult& result, const CgSettings& settings) {
+  return "max_iterations (" + std::to_string(settings.max_iterations) +
+         ") reached at relative residual " + format_residual(result.residual) + " (tolerance " +
+         format_residual(settings.tolerance) + ")";
+}
 
 std::unique_ptr<LinearSolver> make_cpu_solver(CgPreconditioner preconditioner) {
   return std::make_unique<CpuCgSolver>(preconditioner);

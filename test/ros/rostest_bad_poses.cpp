@@ -52,8 +52,7 @@ struct Fixture : testing::Test {
     spin_for(0.2);
   }
 
-  void send(double x, double y, double z, const std::string& frame = "tissue",
-            double qw = 1.0) {
+  void send(double x, double y, double z, const std::string& frame = "tissue", double qw = 1.0) {
     geometry_msgs::PoseStamped p;
     p.header.frame_id = frame;
     p.header.stamp = ros::Time(1.0);  // ancient stamp: never a reason to drop
@@ -79,9 +78,13 @@ constexpr double kX = 0.10, kY = 0.003, kZ = 0.048;
 
 }  // namespace
 
-TEST_F(Fixture, FirstPoseIsNeverAJump) {
-  send(0.5, 0.0, 0.0);  // 0.5 m from anything, but the first pose since ~reset
-  EXPECT_TRUE(blade_at(0.5, 0.0, 0.0));
+TEST_F(Fixture, FirstPoseMustBeNearTheTissue) {
+  send(10.0, 0.0, 0.0);  // 10 m away: refused even as the first pose since ~reset
+  send(1e300, 0.0, 0.0);
+  spin_for(1.2);  // ~markers repeats at least once a second
+  EXPECT_FALSE(blade) << "a first pose far from the tissue was accepted";
+  send(kX, kY, kZ);  // 4 cm outside the thigh: within ~max_pose_jump of its box
+  EXPECT_TRUE(blade_at(kX, kY, kZ));
 }
 
 TEST_F(Fixture, BadPosesDroppedAndRateKept) {
@@ -101,18 +104,30 @@ TEST_F(Fixture, BadPosesDroppedAndRateKept) {
   int sent = 0;
   while (ros::WallTime::now() < end) {
     switch (sent++ % 5) {
-      case 0: send(nan, kY, kZ); break;
-      case 1: send(kX, inf, kZ); break;
-      case 2: send(kX, kY, kZ, "tissue", 0.0); break;
-      case 3: send(kX + 0.001, kY, kZ, "no_such_frame"); break;
-      case 4: send(kX + 1.0, kY, kZ); break;
+      case 0:
+        send(nan, kY, kZ);
+        break;
+      case 1:
+        send(kX, inf, kZ);
+        break;
+      case 2:
+        send(kX, kY, kZ, "tissue", 0.0);
+        break;
+      case 3:
+        send(kX + 0.001, kY, kZ, "no_such_frame");
+        break;
+      case 4:
+        send(kX + 1.0, kY, kZ);
+        break;
     }
     ros::spinOnce();
     ros::WallDuration(0.0025).sleep();
   }
   const int during = stats_count;
-  std::printf("[bad_poses] ~stats: %d msgs in 2 s before, %d in 2 s under %d bad poses; "
-              "node reports %.1f Hz\n", baseline, during, sent, rate_hz);
+  std::printf(
+      "[bad_poses] ~stats: %d msgs in 2 s before, %d in 2 s under %d bad poses; "
+      "node reports %.1f Hz\n",
+      baseline, during, sent, rate_hz);
   EXPECT_GT(baseline, 100) << "~stats should come at ~100 Hz";
   EXPECT_GE(during, 0.8 * baseline) << "the node must keep its rate under bad input";
 

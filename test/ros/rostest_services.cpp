@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <deque>
 #include <fstream>
 #include <string>
@@ -46,21 +47,22 @@ struct Fixture : testing::Test {
     ASSERT_TRUE(spin_until([this] { return !surfaces.empty(); }, 10.0));
   }
 
-  // Calls ~reset and returns the surface the node published right after it (its header.seq is
-  // the surface_version the reset response reports).
+  // Calls ~reset and returns the first surface the node published after it with as many
+  // points as the initial surface (every surface before the reset in these tests is either the
+  // initial one or a cut one, which has more points). No state travels in strings.
   bool reset_and_capture(visualization_msgs::Marker* out) {
+    static const size_t initial_points = [] {
+      stc::Simulation fresh(stc::make_thigh_scene());
+      return 3 * fresh.surface().triangles.size();
+    }();
+    tissue_test::spin_for(0.1);
+    surfaces.clear();
     std_srvs::Trigger t;
     if (!ros::service::call("/tissue/reset", t) || !t.response.success) return false;
-    const std::string key = "surface_version ";
-    const size_t at = t.response.message.find(key);
-    if (at == std::string::npos) return false;
-    const std::string version =
-        t.response.message.substr(at + key.size(),
-                                  t.response.message.find(')', at) - at - key.size());
     return spin_until(
         [&] {
           for (const auto& s : surfaces)
-            if (std::to_string(s.header.seq) == version) {
+            if (s.points.size() == initial_points) {
               *out = s;
               return true;
             }
@@ -149,8 +151,7 @@ TEST_F(Fixture, CutInUnknownFrameIsRefused) {
   cut.request.poses = stroke("no_such_frame");
   ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
   EXPECT_FALSE(cut.response.success);
-  EXPECT_NE(cut.response.message.find("no_such_frame"), std::string::npos)
-      << cut.response.message;
+  EXPECT_NE(cut.response.message.find("no_such_frame"), std::string::npos) << cut.response.message;
 }
 
 TEST_F(Fixture, SetCutting) {
@@ -191,6 +192,57 @@ TEST_F(Fixture, SaveWritesReadableVtk) {
   std::ifstream json(save.request.stats_path);
   std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"tets\""), std::string::npos) << text;
+}
+
+TEST_F(Fixture, RepeatedCutGivesTheTrueReason) {
+  visualization_msgs::Marker initial;
+  ASSERT_TRUE(reset_and_capture(&initial));
+  soft_tissue_cutting::Cut cut;
+  cut.request.poses = stroke();
+  ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+  ASSERT_TRUE(cut.response.success) << cut.response.message;
+  // Again: a pass or two may still open faces where the first one snapped; then the reply
+  // names the true reason (not "does not cross the operation part").
+  int passes = 0;
+  do {
+    ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+    ++passes;
+  } while (cut.response.success && passes < 5);
+  EXPECT_LE(passes, 3);
+  EXPECT_FALSE(cut.response.success);
+  EXPECT_NE(cut.response.message.find("already cut"), std::string::npos) << cut.response.message;
+}
+
+TEST_F(Fixture, ZeroQuaternionAndLongFramesAreReportedBriefly) {
+  soft_tissue_cutting::Cut cut;
+  cut.request.poses = stroke();
+  cut.request.poses[3].pose.orientation.w = 0;
+  ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+  EXPECT_FALSE(cut.response.success);
+  EXPECT_EQ(cut.response.message, "pose 3: zero quaternion");
+  cut.request.poses = stroke(std::string(1 << 20, 'f'));  // a 1 MB frame name
+  ASSERT_TRUE(ros::service::call("/tissue/cut", cut));
+  EXPECT_FALSE(cut.response.success);
+  EXPECT_LT(cut.response.message.size(), 600u);
+  EXPECT_NE(cut.response.message.find("(1048576 bytes)"), std::string::npos);
+}
+
+TEST_F(Fixture, SaveSucceedsOnlyWhenEverythingWasWritten) {
+  const std::string base = "/tmp/rostest_services_partial_" + std::to_string(getpid());
+  std::remove((base + ".vtk").c_str());
+  soft_tissue_cutting::SaveMesh save;
+  save.request.path = base + ".vtk";
+  save.request.stats_path = "/nonexistent_dir_for_tissue_test/x.json";
+  ASSERT_TRUE(ros::service::call("/tissue/save", save));
+  EXPECT_FALSE(save.response.success);
+  EXPECT_NE(save.response.message.find("x.json"), std::string::npos) << save.response.message;
+  EXPECT_FALSE(std::ifstream(save.request.path).good()) << "a failed ~save left a partial VTK";
+  EXPECT_FALSE(std::ifstream(save.request.path + ".part").good());
+  save.request.path = "/tmp/" + std::string(1 << 20, 'p') + ".vtk";
+  save.request.stats_path = "";
+  ASSERT_TRUE(ros::service::call("/tissue/save", save));
+  EXPECT_FALSE(save.response.success);
+  EXPECT_LT(save.response.message.size(), 600u);
 }
 
 TEST_F(Fixture, SaveToBadPathReportsErrorAndNodeLivesOn) {

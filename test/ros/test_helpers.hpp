@@ -30,8 +30,8 @@ inline void spin_for(double seconds) {
 
 struct TriangleSoup {
   int triangles = 0;
-  int vertices = 0;         // distinct positions
-  int bad_edges = 0;        // undirected edges not used exactly twice in opposite directions
+  int vertices = 0;   // distinct positions
+  int bad_edges = 0;  // undirected edges not used exactly twice in opposite directions
 };
 
 // Welds a TRIANGLE_LIST's points by exact coordinates and checks that it is closed and

@@ -16,8 +16,7 @@
 
 namespace stc::testing_scenes {
 
-inline Scene liver_scene(const std::string& file, bool gravity, int loaded,
-                         double region_fraction,
+inline Scene liver_scene(const std::string& file, bool gravity, int loaded, double region_fraction,
                          OperationRegion::Kind kind = OperationRegion::Kind::kSphere) {
   Scene s;
   s.source = file;
@@ -30,8 +29,8 @@ inline Scene liver_scene(const std::string& file, bool gravity, int loaded,
     fixed.nodes = {2, 38, 63};
   } else {
     fixed.kind = NodeSelector::Kind::kBox;
-    fixed.box = Box{lo - Vec3::Constant(1),
-                    Vec3(lo.x() + 0.1 * (hi.x() - lo.x()), hi.y() + 1, hi.z() + 1)};
+    fixed.box =
+        Box{lo - Vec3::Constant(1), Vec3(lo.x() + 0.1 * (hi.x() - lo.x()), hi.y() + 1, hi.z() + 1)};
   }
   s.fixed.push_back(fixed);
   std::vector<std::pair<double, int>> top;
@@ -44,7 +43,8 @@ inline Scene liver_scene(const std::string& file, bool gravity, int loaded,
   s.loads.push_back(load);
   if (gravity) s.gravity = Vec3(0, -9.81, 0);
   s.operation_region.kind = kind;
-  s.operation_region.sphere = Sphere{s.mesh.nodes[top[0].second], region_fraction * (hi - lo).maxCoeff()};
+  s.operation_region.sphere =
+      Sphere{s.mesh.nodes[top[0].second], region_fraction * (hi - lo).maxCoeff()};
   return s;
 }
 

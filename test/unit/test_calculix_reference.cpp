@@ -1,4 +1,4 @@
-// The full model and the hybrid model against CalculiX C3D4 (docs/REFERENCES.md): the test
+// The full model and the hybrid model against CalculiX C3D4 (docs/DESIGN.md section 12): the test
 // writes the .inp deck, runs `ccx -i job` in a temporary directory and parses job.dat.
 // Pass: max nodal difference <= 1e-6 of the largest displacement (CalculiX prints 7 digits).
 #include "soft_tissue_cutting/assembly/full_model.hpp"
@@ -136,13 +136,14 @@ void check_against_calculix(const Scene& s, const char* name) {
   EXPECT_LE(e_full, 1e-6);
   EXPECT_LE(e_hybrid, 1e-6);
   double umax = 0;
-  for (Eigen::Index n = 0; n < ccx.size() / 3; ++n) umax = std::max(umax, ccx.segment<3>(3 * n).norm());
-  std::printf("[ calculix ] %-22s %5d nodes %6d tets |u|max %.4e m: full %.2e, hybrid %.2e\n",
-              name, s.mesh.num_nodes(), s.mesh.num_tets(), umax, e_full, e_hybrid);
+  for (Eigen::Index n = 0; n < ccx.size() / 3; ++n)
+    umax = std::max(umax, ccx.segment<3>(3 * n).norm());
+  std::printf("[ calculix ] %-22s %5d nodes %6d tets |u|max %.4e m: full %.2e, hybrid %.2e\n", name,
+              s.mesh.num_nodes(), s.mesh.num_tets(), umax, e_full, e_hybrid);
 }
 
-// docs/REFERENCES.md cantilever: 0.1 x 0.02 x 0.02 m, E = 1e4, nu = 0.3, x = 0 fixed, tip
-// force 1e-4 N (-z) spread over the x = L face by tributary area.
+// The cantilever of docs/DESIGN.md section 12: 0.1 x 0.02 x 0.02 m, E = 1e4, nu = 0.3, x = 0 fixed,
+// tip force 1e-4 N (-z) spread over the x = L face by tributary area.
 Scene cantilever_scene(std::array<int, 3> cells) {
   Scene s;
   s.source = "cantilever";
@@ -209,11 +210,15 @@ Scene liver_scene(const std::string& file, bool gravity) {
   return testing_scenes::liver_scene(file, gravity, 3, 0.25);
 }
 
-TEST(CalculixReference, SofaLiver) { check_against_calculix(liver_scene("sofa_liver.msh", false), "sofa_liver"); }
+TEST(CalculixReference, SofaLiver) {
+  check_against_calculix(liver_scene("sofa_liver.msh", false), "sofa_liver");
+}
 TEST(CalculixReference, SofaLiverGravity) {
   check_against_calculix(liver_scene("sofa_liver.msh", true), "sofa_liver + gravity");
 }
-TEST(CalculixReference, SofaLiver2) { check_against_calculix(liver_scene("sofa_liver2.msh", false), "sofa_liver2"); }
+TEST(CalculixReference, SofaLiver2) {
+  check_against_calculix(liver_scene("sofa_liver2.msh", false), "sofa_liver2");
+}
 TEST(CalculixReference, SofaLiver2Gravity) {
   check_against_calculix(liver_scene("sofa_liver2.msh", true), "sofa_liver2 + gravity");
 }

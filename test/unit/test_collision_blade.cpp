@@ -33,7 +33,8 @@ TEST(CollisionBvh, SegmentCandidatesMatchBruteForceOnTheDeformedThigh) {
     for (size_t t = 0; t < bvh.surface().triangles.size(); ++t) {
       const Tri& n = bvh.surface().triangles[t].nodes;
       double s;
-      if (segment_crosses_triangle(a, b, bvh.position(n[0]), bvh.position(n[1]), bvh.position(n[2]), s)) {
+      if (segment_crosses_triangle(a, b, bvh.position(n[0]), bvh.position(n[1]), bvh.position(n[2]),
+                                   s)) {
         EXPECT_TRUE(std::binary_search(fast.begin(), fast.end(), static_cast<int>(t)));
       }
     }

@@ -46,7 +46,8 @@ struct Cube {
   void expect_invariants() const {
     InvariantLimits limits;
     limits.initial_volume = v0;
-    for (const auto& v : check_cut_invariants(mesh, state.origin_volume, limits)) ADD_FAILURE() << v;
+    for (const auto& v : check_cut_invariants(mesh, state.origin_volume, limits))
+      ADD_FAILURE() << v;
   }
 };
 

@@ -1,7 +1,7 @@
 // Property tests of cut insertion: thousands of seeded random blade sweeps on the box, the
 // thigh's operation part and the SOFA liver, biased to the hard cases (through nodes, along
-// edges and faces, repeated, continued, severing). After EVERY sweep all SPEC 6 invariants
-// must hold (cutting/invariants.hpp).
+// edges and faces, repeated, continued, severing). After EVERY sweep all invariants of
+// docs/SCENE.md "Cut invariants" must hold (cutting/invariants.hpp).
 #include "soft_tissue_cutting/cutting/cut_measures.hpp"
 #include "soft_tissue_cutting/cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_sweep.hpp"
@@ -39,7 +39,8 @@ Vec3 centroid(const TetMesh& mesh, int t) {
 
 // Operation part = tets whose centroid `in_region` accepts; locked = nodes they share with
 // the rest (make_cut_state locks every node of a non-cuttable tet).
-Specimen make_specimen(std::string name, TetMesh mesh, const std::function<bool(const Vec3&)>& in_region) {
+Specimen make_specimen(std::string name, TetMesh mesh,
+                       const std::function<bool(const Vec3&)>& in_region) {
   Specimen s;
   s.name = std::move(name);
   s.mesh = std::move(mesh);
@@ -112,8 +113,8 @@ class SweepGenerator {
 
   Sweep next(const TetMesh& mesh, const CutState& state) {
     std::uniform_int_distribution<int> pick(0, 6);
-    const SweepKind kind = has_last_ ? static_cast<SweepKind>(pick(rng_))
-                                     : static_cast<SweepKind>(pick(rng_) % 4);
+    const SweepKind kind =
+        has_last_ ? static_cast<SweepKind>(pick(rng_)) : static_cast<SweepKind>(pick(rng_) % 4);
     Sweep sweep = make(kind, mesh, state);
     last_ = sweep;
     has_last_ = true;
@@ -148,7 +149,8 @@ class SweepGenerator {
     switch (kind) {
       case SweepKind::kRandom: {
         const Vec3 p = s_.centre + s_.reach * uniform(0, 0.8) * random_unit(rng_);
-        return through(p, random_unit(rng_), uniform(0.5, 4) * h * random_unit(rng_), uniform(1, 6) * h, kind);
+        return through(p, random_unit(rng_), uniform(0.5, 4) * h * random_unit(rng_),
+                       uniform(1, 6) * h, kind);
       }
       case SweepKind::kThroughNode: {
         const Tet t = some_tet(mesh, state);
@@ -158,7 +160,8 @@ class SweepGenerator {
       case SweepKind::kAlongEdge: {  // the sweep plane contains a mesh edge
         const Tet t = some_tet(mesh, state);
         const Vec3 e = (mesh.nodes[t[1]] - mesh.nodes[t[0]]).normalized();
-        return through(mesh.nodes[t[0]], e, uniform(0.5, 4) * h * random_unit(rng_), uniform(2, 6) * h, kind);
+        return through(mesh.nodes[t[0]], e, uniform(0.5, 4) * h * random_unit(rng_),
+                       uniform(2, 6) * h, kind);
       }
       case SweepKind::kAlongFace: {  // the sweep plane is a face's plane
         const Tet t = some_tet(mesh, state);
@@ -206,7 +209,7 @@ class SweepGenerator {
 
 const char* kind_name(SweepKind k) {
   static const char* names[] = {"random", "through-node", "along-edge", "along-face",
-                                "repeat", "continue", "sever"};
+                                "repeat", "continue",     "sever"};
   return names[static_cast<int>(k)];
 }
 
@@ -290,10 +293,11 @@ void report_quality_after_100_cuts(const Specimen& s, unsigned seed, double min_
   double worst_fraction = 1;
   for (int t = 0; t < mesh.num_tets(); ++t)
     worst_fraction = std::min(worst_fraction, tet_volume(mesh, t) / state.origin_volume[t]);
-  std::printf("%s after 100 sweeps (%d cut): %d tets; min dihedral %.2f deg (%.2f before), "
-              "max %.2f deg; min volume ratio %.4f (%.4f before); smallest tet %.4f of its size class\n",
-              s.name.c_str(), cuts, mesh.num_tets(), after.min_dihedral_deg, before.min_dihedral_deg,
-              after.max_dihedral_deg, after.min_volume_ratio, before.min_volume_ratio, worst_fraction);
+  std::printf(
+      "%s after 100 sweeps (%d cut): %d tets; min dihedral %.2f deg (%.2f before), "
+      "max %.2f deg; min volume ratio %.4f (%.4f before); smallest tet %.4f of its size class\n",
+      s.name.c_str(), cuts, mesh.num_tets(), after.min_dihedral_deg, before.min_dihedral_deg,
+      after.max_dihedral_deg, after.min_volume_ratio, before.min_volume_ratio, worst_fraction);
   EXPECT_GT(after.min_dihedral_deg, min_dihedral);
   EXPECT_GT(after.min_volume_ratio, min_ratio);
   EXPECT_GE(worst_fraction, CutOptions{}.min_volume_fraction * (1 - 1e-9));

@@ -1,5 +1,5 @@
 // The two preconditioners of the CPU projected CG (solve/linear_solver.hpp) on the thigh's
-// hybrid system (METHOD.md section 3, eq. 17): same solution as the direct CHOLMOD solve, with
+// hybrid system (docs/DESIGN.md eq. (10)): same solution as the direct CHOLMOD solve, with
 // and without constrained (contact) DOFs; the Cholesky preconditioner converges in about
 // #constrained iterations where Jacobi needs hundreds; matrices that cannot be factored fall
 // back observably instead of crashing.
@@ -169,8 +169,8 @@ TEST(FemCgPreconditioner, HeldFreePieceUsesShiftedCholesky) {
 // No SPD factor even shifted (indefinite): Jacobi for that matrix, no crash; the next SPD
 // matrix is factored again.
 TEST(FemCgPreconditioner, IndefiniteMatrixFallsBackToJacobi) {
-  std::vector<Eigen::Triplet<double, int>> t = {{0, 0, 1.0}, {1, 1, 1.0}, {0, 1, 2.0},
-                                                {1, 0, 2.0}, {2, 2, 3.0}};
+  std::vector<Eigen::Triplet<double, int>> t = {
+      {0, 0, 1.0}, {1, 1, 1.0}, {0, 1, 2.0}, {1, 0, 2.0}, {2, 2, 3.0}};
   SparseMatrix a(3, 3);
   a.setFromTriplets(t.begin(), t.end());
   auto cg = make_cpu_solver(CgPreconditioner::kCholesky);

@@ -1,4 +1,5 @@
-// Linear tet element stiffness (METHOD.md section 1): symmetry, rigid-body null space, patch test.
+// Linear tet element stiffness (docs/DESIGN.md section 2): symmetry, rigid-body null space, patch
+// test.
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/global_assembly.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
@@ -12,8 +13,7 @@
 namespace stc {
 namespace {
 
-const Vec3 kX0(0.01, -0.02, 0.03), kX1(0.9, 0.1, -0.05), kX2(0.2, 1.1, 0.15),
-    kX3(0.05, 0.3, 0.8);
+const Vec3 kX0(0.01, -0.02, 0.03), kX1(0.9, 0.1, -0.05), kX2(0.2, 1.1, 0.15), kX3(0.05, 0.3, 0.8);
 
 TEST(FemElement, SymmetricPositiveSemidefinite) {
   const Mat12 k = element_stiffness(kX0, kX1, kX2, kX3, 3000.0, 0.45);
@@ -32,8 +32,10 @@ TEST(FemElement, RigidBodyModesInNullSpace) {
     Eigen::Matrix<double, 12, 1> u;
     for (int a = 0; a < 4; ++a) {
       Vec3 d = Vec3::Zero();
-      if (mode < 3) d[mode] = 1.0;                            // translations
-      else d = Vec3::Unit(mode - 3).cross(x[a]);              // infinitesimal rotations
+      if (mode < 3)
+        d[mode] = 1.0;  // translations
+      else
+        d = Vec3::Unit(mode - 3).cross(x[a]);  // infinitesimal rotations
       u.segment<3>(3 * a) = d;
     }
     EXPECT_LE((k * u).norm(), 1e-12 * k.norm() * u.norm()) << "mode " << mode;
@@ -70,12 +72,14 @@ TEST(FemElement, PatchTestOnBoxMesh) {
   for (int n = 0; n < m.num_nodes(); ++n) {
     const Vec3& x = mesh.nodes[n];
     const bool interior = (x.array() > 1e-12).all() && (x.array() < g.size.array() - 1e-12).all();
-    if (interior) m.nodes[n] += 0.01 * Vec3(std::sin(7.0 * n), std::cos(3.0 * n), std::sin(5.0 * n + 1));
+    if (interior)
+      m.nodes[n] += 0.01 * Vec3(std::sin(7.0 * n), std::cos(3.0 * n), std::sin(5.0 * n + 1));
   }
   for (int t = 0; t < m.num_tets(); ++t) ASSERT_GT(tet_volume(m, t), 0);
   const Material mat{1e4, 0.3, 1000};
   const ElementStiffnessCache cache(m, mat);
-  std::vector<int> nodes(static_cast<size_t>(m.num_nodes())), tets(static_cast<size_t>(m.num_tets()));
+  std::vector<int> nodes(static_cast<size_t>(m.num_nodes())),
+      tets(static_cast<size_t>(m.num_tets()));
   std::iota(nodes.begin(), nodes.end(), 0);
   std::iota(tets.begin(), tets.end(), 0);
   const DofMap dofs = make_dof_map(m.num_nodes(), nodes, {});

@@ -1,10 +1,10 @@
-// The "gl" LinearSolver (whole CG on the GPU + double refinement, METHOD.md section 6) on
+// The "gl" LinearSolver (whole CG on the GPU + double refinement, docs/DESIGN.md section 9) on
 // Mesa llvmpipe, against a direct double solve (Eigen SimplicialLDLT of the reduced system).
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/gpu/test_matrices.hpp"
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
+#include <Eigen/SparseCholesky>
 
 #include <cstdlib>
 #include <random>
@@ -138,14 +138,13 @@ TEST_P(GpuCg, SetMatrixAfterChangeGivesNewSolution) {
   EXPECT_LE((x3 - ref3).norm() / ref3.norm(), 1e-5);
 }
 
-INSTANTIATE_TEST_SUITE_P(Layouts, GpuCg,
-                         ::testing::Values(Case{gpu::SpmvLayout::MethodA, false},
-                                           Case{gpu::SpmvLayout::MethodB, true},
-                                           Case{gpu::SpmvLayout::RowLoop, false},
-                                           Case{gpu::SpmvLayout::RowLoop, true}),
-                         [](const ::testing::TestParamInfo<Case>& i) {
-                           return gpu::layout_name(i.param.layout) + (i.param.dense_block ? "_dense" : "");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Layouts, GpuCg,
+    ::testing::Values(Case{gpu::SpmvLayout::MethodA, false}, Case{gpu::SpmvLayout::MethodB, true},
+                      Case{gpu::SpmvLayout::RowLoop, false}, Case{gpu::SpmvLayout::RowLoop, true}),
+    [](const ::testing::TestParamInfo<Case>& i) {
+      return gpu::layout_name(i.param.layout) + (i.param.dense_block ? "_dense" : "");
+    });
 
 TEST(GpuFallback, ForcedNoEglGivesNullAndOneLineReason) {
   setenv("TISSUE_FORCE_NO_EGL", "1", 1);

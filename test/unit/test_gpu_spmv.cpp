@@ -1,6 +1,6 @@
-// Texture SpMV (METHOD.md section 6) on Mesa llvmpipe: Method A, Method B and the one-pass
-// RowLoop layout against a double-precision CPU SpMV. EGL must work here (RECIPES.md,
-// "Headless EGL compute"): a missing context is a failure, not a skip.
+// Texture SpMV (docs/DESIGN.md section 9) on Mesa llvmpipe: Method A, Method B and the one-pass
+// RowLoop layout against a double-precision CPU SpMV. EGL must work here (docs/DESIGN.md section
+// 14, "Headless EGL compute"): a missing context is a failure, not a skip.
 #include "soft_tissue_cutting/gpu/egl_context.hpp"
 #include "soft_tissue_cutting/gpu/gl_spmv.hpp"
 #include "soft_tissue_cutting/gpu/gl_vector.hpp"
@@ -54,10 +54,12 @@ TEST_P(GpuSpmv, ElasticityLikePoisson3D) {
   const double err = spmv_error(a, &passes);
   RecordProperty("relative_error", std::to_string(err));
   std::printf("[%s] 3D elasticity-like N=%d: rel err %.3g, %d passes (%s, %s, %s)\n",
-              layout_name(GetParam()).c_str(), int(a.rows()), err, passes,
-              ctx_->renderer().c_str(), ctx_->version().c_str(), ctx_->origin().c_str());
+              layout_name(GetParam()).c_str(), int(a.rows()), err, passes, ctx_->renderer().c_str(),
+              ctx_->version().c_str(), ctx_->origin().c_str());
   EXPECT_LE(err, 1e-6);
-  EXPECT_EQ(passes, GetParam() == SpmvLayout::MethodA ? 20 : GetParam() == SpmvLayout::MethodB ? 5 : 1);
+  EXPECT_EQ(passes, GetParam() == SpmvLayout::MethodA   ? 20
+                    : GetParam() == SpmvLayout::MethodB ? 5
+                                                        : 1);
 }
 
 TEST_P(GpuSpmv, DenseInterfaceBlock) {
@@ -83,8 +85,11 @@ TEST_P(GpuSpmv, Table2MatrixHasStatedMaxRow) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, GpuSpmv,
-                         ::testing::Values(SpmvLayout::MethodA, SpmvLayout::MethodB, SpmvLayout::RowLoop),
-                         [](const ::testing::TestParamInfo<SpmvLayout>& i) { return layout_name(i.param); });
+                         ::testing::Values(SpmvLayout::MethodA, SpmvLayout::MethodB,
+                                           SpmvLayout::RowLoop),
+                         [](const ::testing::TestParamInfo<SpmvLayout>& i) {
+                           return layout_name(i.param);
+                         });
 
 }  // namespace
 }  // namespace gpu

@@ -22,12 +22,17 @@ Scene liver(const std::string& file, OperationRegion::Kind kind) {
 
 double max_error(const Vector& u, const Vector& ref, const std::vector<int>& nodes) {
   double scale = 0, err = 0;
-  for (Eigen::Index n = 0; n < ref.size() / 3; ++n) scale = std::max(scale, ref.segment<3>(3 * n).norm());
+  for (Eigen::Index n = 0; n < ref.size() / 3; ++n)
+    scale = std::max(scale, ref.segment<3>(3 * n).norm());
   for (int n : nodes) err = std::max(err, (u.segment<3>(3 * n) - ref.segment<3>(3 * n)).norm());
   return err / scale;
 }
 
-struct Case { const char* file; OperationRegion::Kind kind; const char* name; };
+struct Case {
+  const char* file;
+  OperationRegion::Kind kind;
+  const char* name;
+};
 class HybridLiver : public ::testing::TestWithParam<Case> {};
 
 TEST_P(HybridLiver, EqualsFullModel) {
@@ -56,9 +61,10 @@ TEST_P(HybridLiver, EqualsFullModel) {
   EXPECT_LE(e_surface, 1e-9);
   EXPECT_LE(e_all, 1e-9);
   const HybridModelCounts n = h.counts();
-  std::printf("[ hybrid   ] %-14s %-6s O=%d I=%d S=%d Q=%d dof=%d cg=%d: O+I %.2e, S %.2e, all %.2e\n",
-              c.file, c.name, n.nodes_operation, n.nodes_interface, n.nodes_surface_condensed,
-              n.nodes_interior_condensed, n.dof_operation, r.iterations, e_part1, e_surface, e_all);
+  std::printf(
+      "[ hybrid   ] %-14s %-6s O=%d I=%d S=%d Q=%d dof=%d cg=%d: O+I %.2e, S %.2e, all %.2e\n",
+      c.file, c.name, n.nodes_operation, n.nodes_interface, n.nodes_surface_condensed,
+      n.nodes_interior_condensed, n.dof_operation, r.iterations, e_part1, e_surface, e_all);
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -1,4 +1,4 @@
-// The hybrid condensed model equals the full (uncondensed) model (METHOD.md section 3: "exact,
+// The hybrid condensed model equals the full (uncondensed) model (docs/DESIGN.md section 4: "exact,
 // not an approximation"), for operation regions none / all / sphere / box, with gravity, with
 // imposed displacements, after a change of the operation part, and after a change of E.
 #include "soft_tissue_cutting/assembly/full_model.hpp"
@@ -17,9 +17,9 @@ constexpr double kTight = 1e-13;
 
 // The full model on the hybrid model's current mesh, loads and supports, solved directly.
 struct Reference {
-  Vector u;        // 3n
+  Vector u;  // 3n
   FullModel model;
-  Vector x;        // free DOFs
+  Vector x;  // free DOFs
 };
 Reference full_reference(const HybridModel& h, const ImposedDisplacements& imposed = {}) {
   Reference r;
@@ -41,7 +41,8 @@ Reference full_reference(const HybridModel& h, const ImposedDisplacements& impos
 // max over `nodes` of |u - u_ref| / max over all nodes of |u_ref|.
 double nodal_error(const Vector& u, const Vector& ref, const std::vector<int>& nodes) {
   double scale = 0, err = 0;
-  for (Eigen::Index n = 0; n < ref.size() / 3; ++n) scale = std::max(scale, ref.segment<3>(3 * n).norm());
+  for (Eigen::Index n = 0; n < ref.size() / 3; ++n)
+    scale = std::max(scale, ref.segment<3>(3 * n).norm());
   for (int n : nodes) err = std::max(err, (u.segment<3>(3 * n) - ref.segment<3>(3 * n)).norm());
   return err / scale;
 }
@@ -65,7 +66,11 @@ Scene thigh_with(OperationRegion::Kind kind, bool gravity) {
   return s;
 }
 
-struct Case { OperationRegion::Kind kind; bool gravity; const char* name; };
+struct Case {
+  OperationRegion::Kind kind;
+  bool gravity;
+  const char* name;
+};
 
 class HybridVsFull : public ::testing::TestWithParam<Case> {};
 
@@ -89,11 +94,13 @@ TEST_P(HybridVsFull, Thigh) {
       EXPECT_GT(n.nodes_interior_condensed, 0);
   }
   EXPECT_EQ(n.nodes_operation + n.nodes_interface + n.nodes_surface_condensed +
-                n.nodes_interior_condensed, n.nodes);
+                n.nodes_interior_condensed,
+            n.nodes);
   const CgResult r = h.solve();
   EXPECT_TRUE(r.converged);
   const Reference ref = full_reference(h);
-  // O, I and S are current after solve (S through c_S + R u_I, METHOD 4).
+  // O, I and S are current after solve (S recovered from u_I through K2_NN's factor, docs/DESIGN.md
+  // eq. (13)).
   std::vector<int> visible = part1_nodes(p);
   visible.insert(visible.end(), p.surface.begin(), p.surface.end());
   const double e_visible = nodal_error(h.displacement(), ref.u, visible);
@@ -103,9 +110,12 @@ TEST_P(HybridVsFull, Thigh) {
   EXPECT_LE(e_visible, 1e-9);
   EXPECT_LE(e_surface, 1e-9);
   EXPECT_LE(e_all, 1e-9);
-  std::printf("[ hybrid   ] thigh %-14s part2 tets=%zu O=%d I=%d S=%d Q=%d dof=%d cg=%d: O+I+S %.2e, S %.2e, all %.2e\n",
-              c.name, p.condensed_tets.size(), n.nodes_operation, n.nodes_interface, n.nodes_surface_condensed,
-              n.nodes_interior_condensed, n.dof_operation, r.iterations, e_visible, e_surface, e_all);
+  std::printf(
+      "[ hybrid   ] thigh %-14s part2 tets=%zu O=%d I=%d S=%d Q=%d dof=%d cg=%d: O+I+S %.2e, S "
+      "%.2e, all %.2e\n",
+      c.name, p.condensed_tets.size(), n.nodes_operation, n.nodes_interface,
+      n.nodes_surface_condensed, n.nodes_interior_condensed, n.dof_operation, r.iterations,
+      e_visible, e_surface, e_all);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -118,7 +128,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{OperationRegion::Kind::kNone, true, "none+gravity"}),
     [](const auto& info) {
       std::string s = info.param.name;
-      for (char& ch : s) if (ch == '+') ch = '_';
+      for (char& ch : s)
+        if (ch == '+') ch = '_';
       return s;
     });
 
@@ -165,11 +176,14 @@ void split_edge(HybridModel& h, int a, int b) {
   const int ntets = m.num_tets();
   for (int t = 0; t < ntets; ++t) {
     Tet e = m.tets[t];
-    const bool has_a = std::count(e.begin(), e.end(), a) > 0, has_b = std::count(e.begin(), e.end(), b) > 0;
+    const bool has_a = std::count(e.begin(), e.end(), a) > 0,
+               has_b = std::count(e.begin(), e.end(), b) > 0;
     if (!has_a || !has_b) continue;
     Tet e1 = e, e2 = e;
-    for (int& v : e1) if (v == b) v = mid;
-    for (int& v : e2) if (v == a) v = mid;
+    for (int& v : e1)
+      if (v == b) v = mid;
+    for (int& v : e2)
+      if (v == a) v = mid;
     m.tets[t] = e1;
     m.tets.push_back(e2);
     if (!m.cut_faces.empty()) m.cut_faces.push_back(0);
@@ -243,23 +257,24 @@ TEST(HybridModel, SetYoungModulusEqualsFreshPrecompute) {
   rescaled.solve();
   fresh.solve();
   const std::vector<int> visible = all_nodes(fresh.mesh());
-  const double e_surface = nodal_error(rescaled.displacement(), fresh.displacement(),
-                                       fresh.partition().surface);
+  const double e_surface =
+      nodal_error(rescaled.displacement(), fresh.displacement(), fresh.partition().surface);
   rescaled.recover_interior();
   fresh.recover_interior();
   const double e_all = nodal_error(rescaled.displacement(), fresh.displacement(), visible);
   EXPECT_LE(e_surface, 1e-9);
   EXPECT_LE(e_all, 1e-9);
-  std::printf("[ young    ] set_young_modulus vs fresh precompute: S %.2e, all %.2e\n", e_surface, e_all);
+  std::printf("[ young    ] set_young_modulus vs fresh precompute: S %.2e, all %.2e\n", e_surface,
+              e_all);
 }
 
 TEST(HybridModel, PrecomputeTimingsReported) {
   const HybridModel h(make_thigh_scene());
   const auto& t = h.precompute_timings_ms();
   double parts = 0;
-  for (const char* k : {"partition", "element_stiffness", "condensation_assembly", "condensation_factor",
-                        "condensation_solve", "condensation_products", "recovery_operator",
-                        "hybrid_assembly"}) {
+  for (const char* k :
+       {"partition", "element_stiffness", "condensation_assembly", "condensation_factor",
+        "condensation_solve", "condensation_products", "hybrid_assembly"}) {
     ASSERT_TRUE(t.count(k)) << k;
     EXPECT_GE(t.at(k), 0.0);
     parts += t.at(k);

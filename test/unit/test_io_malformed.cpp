@@ -1,5 +1,5 @@
-// Malformed input for every reader (SPEC 3): each case must throw MeshError with one line
-// that starts with the file's path and, where a line applies, names it. Plus a fuzz loop:
+// Malformed input for every reader (docs/SCENE.md "Meshes"): each case must throw MeshError with
+// one line that starts with the file's path and, where a line applies, names it. Plus a fuzz loop:
 // random byte mutations of valid files load or throw MeshError, never anything else.
 #include "test_io_util.hpp"
 

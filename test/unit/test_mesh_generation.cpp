@@ -16,7 +16,8 @@ namespace {
 double enclosed_volume(const TetMesh& mesh, const BoundarySurface& s) {
   double v = 0;
   for (const auto& t : s.triangles) {
-    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]], &c = mesh.nodes[t.nodes[2]];
+    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]],
+               &c = mesh.nodes[t.nodes[2]];
     v += a.dot(b.cross(c)) / 6.0;
   }
   return v;
@@ -44,10 +45,10 @@ TEST(ThighScene, NonOperationPartNearPaper) {
     EXPECT_GT(tet_volume(scene.mesh, t), 0);
   }
   const int condensed = scene.mesh.num_tets() - operation;
-  std::printf("thigh: %d tets, %d nodes; operation part %d tets; non-operation part %d tets, "
-              "%zu nodes (paper: 2134 tets, 633 nodes)\n",
-              scene.mesh.num_tets(), scene.mesh.num_nodes(), operation, condensed,
-              condensed_nodes.size());
+  std::printf(
+      "thigh: %d tets, %d nodes; operation part %d tets; non-operation part %d tets, "
+      "%zu nodes (paper: 2134 tets, 633 nodes)\n",
+      scene.mesh.num_tets(), scene.mesh.num_nodes(), operation, condensed, condensed_nodes.size());
   EXPECT_NEAR(condensed, 2134, 0.1 * 2134);
   EXPECT_NEAR(static_cast<double>(condensed_nodes.size()), 633, 0.1 * 633);
   EXPECT_GT(operation, 500);  // refined: the scalpel has room to cut
@@ -73,7 +74,8 @@ TEST(ThighMesh, VolumeMatchesTubeWithinPolygonError) {
   // The tube's circular walls become regular 13-gons: the exact discrete volume is
   // (n/2) sin(2 pi / n) (ro^2 - ri^2) L, which differs from the analytic pi (ro^2 - ri^2) L
   // by the polygon's chord error, 1 - sin(2 pi/n) n / (2 pi) = 3.8 % for n = 13.
-  const double annulus = (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius) * g.length;
+  const double annulus =
+      (g.outer_radius * g.outer_radius - g.inner_radius * g.inner_radius) * g.length;
   const int n = 13;
   const double discrete = 0.5 * n * std::sin(2 * M_PI / n) * annulus;
   const double analytic = M_PI * annulus;
@@ -111,7 +113,8 @@ TEST(BoundarySurface, ThighIsClosedManifoldWithOutwardNormals) {
   for (const auto& t : s.triangles) {
     const Tet& tet = mesh.tets[t.tet];
     const Vec3 inner = mesh.nodes[tet[t.face]];
-    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]], &c = mesh.nodes[t.nodes[2]];
+    const Vec3 &a = mesh.nodes[t.nodes[0]], &b = mesh.nodes[t.nodes[1]],
+               &c = mesh.nodes[t.nodes[2]];
     EXPECT_LT((b - a).cross(c - a).dot(inner - a), 0);
   }
 }

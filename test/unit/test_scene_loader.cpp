@@ -1,5 +1,6 @@
-// Scene loader (SPEC 3): the example scenes, the built-in thigh, scaling before selectors, and
-// a table of refused scenes whose one-line message must name the file, the key and the line.
+// Scene loader (docs/SCENE.md "Scene file"): the example scenes, the built-in thigh, scaling before
+// selectors, and a table of refused scenes whose one-line message must name the file, the key and
+// the line.
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 
 #include "test_io_util.hpp"

@@ -1,5 +1,6 @@
-// The whole per-step pipeline (METHOD 5): contact, pressure-triggered cutting, solve, and the
-// contracts a cut leaves behind (SPEC 6), checked against the full uncondensed model.
+// The whole per-step pipeline (docs/DESIGN.md section 10): contact, pressure-triggered cutting,
+// solve, and the contracts a cut leaves behind (docs/SCENE.md "Cut invariants"), checked against
+// the full uncondensed model.
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
@@ -189,11 +190,12 @@ TEST(SimulationPipeline, RefusesBadInput) {
   EXPECT_EQ(sim.counts().cuts, 0);
 }
 
-// The shipped cantilever example is REFERENCES.md's beam: before its scalpel moves, the mean
-// tip deflection is the linear-tet figure 2.016e-4 m (Euler-Bernoulli: 2.5e-4 m); its
-// trajectory then presses into the top face, yields and cuts a slit across the bar.
+// The shipped cantilever example is the beam of docs/DESIGN.md section 12: before its scalpel
+// moves, the mean tip deflection is the linear-tet figure 2.016e-4 m (Euler-Bernoulli: 2.5e-4 m);
+// its trajectory then presses into the top face, yields and cuts a slit across the bar.
 TEST(SimulationPipeline, CantileverExampleMatchesReferenceThenCuts) {
-  const Scene scene = load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/cantilever.yaml");
+  const Scene scene =
+      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/cantilever.yaml");
   Simulation sim(scene);
   double tip = 0;
   int n = 0;
@@ -265,7 +267,8 @@ TEST(SimulationPipeline, StraightCutThroughBlockOpens) {
   // Nodes duplicated along the cut share a rest position; the two sides now move apart.
   std::map<std::array<double, 3>, std::vector<int>> at;
   const TetMesh& m = sim.mesh();
-  for (int i = 0; i < m.num_nodes(); ++i) at[{m.nodes[i].x(), m.nodes[i].y(), m.nodes[i].z()}].push_back(i);
+  for (int i = 0; i < m.num_nodes(); ++i)
+    at[{m.nodes[i].x(), m.nodes[i].y(), m.nodes[i].z()}].push_back(i);
   const Vector& u = sim.model().displacement();
   double opening = 0, umax = 0;
   for (const auto& [x, nodes] : at)

@@ -1,20 +1,24 @@
-// SPEC 6 at the simulation level: random blade sweeps through the thigh's operation part via
-// Simulation::cut_along (cut insertion + re-assembly + free pieces held + solve). After every
-// sweep: the geometric invariants, a symmetric hybrid matrix that is positive definite on the
-// free DOF (held pieces excluded: they are constrained), a converged finite solution.
+// docs/SCENE.md "Cut invariants" at the simulation level: random blade sweeps through the thigh's
+// operation part via Simulation::cut_along (cut insertion + re-assembly + free pieces held +
+// solve). After every sweep: the geometric invariants, a symmetric hybrid matrix that is positive
+// definite on the free DOF (held pieces excluded: they are constrained), a converged finite
+// solution.
 #include "cut_fidelity_scenes.hpp"
 
 #include "soft_tissue_cutting/cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
+#include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <random>
+#include <string>
 
 namespace stc {
 namespace {
@@ -42,34 +46,56 @@ SparseMatrix free_block(const Simulation& sim) {
   return out;
 }
 
-TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
-  const Scene scene = make_thigh_scene();
-  Simulation sim(scene);
-  std::mt19937 rng(20261122);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const Vec3 centre = scene.operation_region.sphere.center;
-  int cuts = 0;
-  constexpr int kSweeps = 300;
-  for (int k = 0; k < kSweeps; ++k) {
+// One random stroke: a straight sweep of `length` * U(-1, 1)^3 starting within `spread` of
+// `centre` (x biased outward by `bias`), one random blade orientation.
+struct RandomStrokes {
+  std::mt19937 rng;
+  std::uniform_real_distribution<double> unit{-1.0, 1.0};
+  explicit RandomStrokes(unsigned seed) : rng(seed) {}
+  std::vector<BladePose> next(const Vec3& centre, double spread, double length, double bias) {
     BladePose a, b;
-    a.position = centre + 0.02 * Vec3(unit(rng) - 0.5, unit(rng), unit(rng));
-    b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
+    a.position = centre + spread * Vec3(unit(rng) - bias, unit(rng), unit(rng));
+    b.position = a.position + length * Vec3(unit(rng), unit(rng), unit(rng));
     a.orientation = Eigen::Quaterniond(
         Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
     b.orientation = a.orientation;
-    const CutOutcome out = sim.cut_along({a, b});
+    return {a, b};
+  }
+};
+
+// Cuts `strokes` random strokes and checks the cut invariants (docs/SCENE.md "Cut invariants"),
+// symmetry and the solve after every one, and positive definiteness (a sparse Cholesky of the free
+// block) after every `spd_every`-th and the last; returns how many cut.
+int run_random_strokes(Simulation& sim, RandomStrokes& random, int strokes, const Vec3& centre,
+                       double spread, double length, double bias, int spd_every = 1) {
+  int cuts = 0;
+  for (int k = 0; k < strokes; ++k) {
+    const CutOutcome out = sim.cut_along(random.next(centre, spread, length, bias));
     cuts += out.success;
     InvariantLimits limits;
     limits.initial_volume = sim.counts().volume_initial;
     const auto violated = check_cut_invariants(sim.mesh(), sim.tet_size_classes(), limits);
-    ASSERT_TRUE(violated.empty()) << "sweep " << k << ": " << violated.front();
+    EXPECT_TRUE(violated.empty()) << "sweep " << k << ": " << violated.front();
     const SparseMatrix& a_full = sim.model().hybrid_matrix();
-    ASSERT_LT((SparseMatrix(a_full.transpose()) - a_full).norm(), 1e-12 * a_full.norm())
+    EXPECT_LT((SparseMatrix(a_full.transpose()) - a_full).norm(), 1e-12 * a_full.norm())
         << "sweep " << k;
-    EXPECT_NO_THROW(SparseCholesky{free_block(sim)}) << "sweep " << k << ": not SPD";
-    ASSERT_TRUE(sim.model().last_result().converged) << "sweep " << k;
-    ASSERT_TRUE(sim.model().displacement().allFinite()) << "sweep " << k;
+    if (k % spd_every == 0 || k + 1 == strokes) {
+      EXPECT_NO_THROW(SparseCholesky{free_block(sim)}) << "sweep " << k << ": not SPD";
+    }
+    EXPECT_TRUE(sim.model().last_result().converged) << "sweep " << k;
+    EXPECT_TRUE(sim.model().displacement().allFinite()) << "sweep " << k;
+    if (::testing::Test::HasFailure()) return cuts;
   }
+  return cuts;
+}
+
+TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
+  const Scene scene = make_thigh_scene();
+  Simulation sim(scene);
+  RandomStrokes random(20261122);
+  constexpr int kSweeps = 300;
+  const int cuts = run_random_strokes(sim, random, kSweeps, scene.operation_region.sphere.center,
+                                      0.02, 0.03, 0.5);
   std::printf("random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n", cuts,
               kSweeps, sim.counts().tets_split, sim.counts().tets, sim.counts().free_pieces_held);
   EXPECT_GT(cuts, kSweeps / 3);
@@ -77,7 +103,7 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
 
 // The same on a TetGen liver sagging under gravity (issue 9): 100 random strokes through its
 // operation part, each stroke carried to rest coordinates through the sag. After every
-// stroke: SPEC 6, an SPD system on the free DOF, a converged finite solution. The smallest
+// stroke: docs/SCENE.md "Cut invariants", an SPD system on the free DOF, a converged finite solution. The smallest
 // dihedral angle and the CG iterations of the solve after each stroke are reported (issue 9
 // item 4 asks for >= 5 deg and <= 2x the uncut mesh's iterations; see README, not yet met).
 TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
@@ -126,6 +152,30 @@ TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
   // Not asserted (README, known limitations): after some strokes CG stops converging (16 of
   // 100 here, the residual diverging although the free block is SPD) - the CG preconditioner
   // is factored with pieces that hang on by a node; the solver owner's to fix.
+}
+
+// The same property on a TetGen liver (config/scenes/liver2_surface.yaml, tetrahedralized from
+// config/meshes/sofa_liver2.obj): 200 seeded strokes in CI (a 1,000-stroke run takes ~20 min on
+// the 2-core CI machine, and it found a solve that stops converging at stroke 362 after 28k tets
+// were split: an open problem); TISSUE_RANDOM_CUT_STROKES=1000 or 10000 (./tissue test
+// --strokes N) runs the nightly sizes. When the operation part is cut to pieces the
+// strokes go on: every later cut must keep the same properties. The Cholesky SPD check runs
+// every 10th stroke (it dominates the run time); the other checks after every stroke.
+TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6AndAnSpdSystem) {
+  int strokes = 200;
+  if (const char* env = std::getenv("TISSUE_RANDOM_CUT_STROKES")) strokes = std::atoi(env);
+  ASSERT_GT(strokes, 0) << "TISSUE_RANDOM_CUT_STROKES must be a positive number";
+  const Scene scene =
+      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/liver2_surface.yaml");
+  Simulation sim(scene);
+  RandomStrokes random(20261123);
+  const double r = scene.operation_region.sphere.radius;
+  const int cuts = run_random_strokes(sim, random, strokes, scene.operation_region.sphere.center,
+                                      0.8 * r, 0.8 * r, 0.0, 10);
+  std::printf("liver random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n",
+              cuts, strokes, sim.counts().tets_split, sim.counts().tets,
+              sim.counts().free_pieces_held);
+  EXPECT_GT(cuts, strokes / 4);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // Per-tet element stiffness matrices, kept so that after a cut only the changed tets are
-// recomputed (METHOD.md section 5 step 4: "re-assemble only the changed elements").
+// recomputed (docs/DESIGN.md section 8: "re-assemble only the changed elements").
 #pragma once
 
 #include "soft_tissue_cutting/assembly/element_stiffness.hpp"

@@ -1,4 +1,4 @@
-// Linear tetrahedron stiffness (METHOD.md section 1): K_e = V B^T D B, 12 x 12.
+// Linear tetrahedron stiffness (docs/DESIGN.md section 2): K_e = V B^T D B, 12 x 12.
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"

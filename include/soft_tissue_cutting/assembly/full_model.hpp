@@ -1,5 +1,5 @@
 // The general (uncondensed) model: K over every free DOF of the whole mesh. The reference the
-// hybrid model must equal (METHOD.md section 3: "exact, not an approximation"), and the
+// hybrid model must equal (docs/DESIGN.md section 4: "exact, not an approximation"), and the
 // "general model" of the paper's Table 1.
 #pragma once
 
@@ -9,9 +9,9 @@
 namespace stc {
 
 struct FullModel {
-  DofMap dofs;      // every DOF of a tet-referenced, non-fixed node
-  SparseMatrix K;   // K_ff
-  Vector f;         // f_f (point loads + gravity)
+  DofMap dofs;     // every DOF of a tet-referenced, non-fixed node
+  SparseMatrix K;  // K_ff
+  Vector f;        // f_f (point loads + gravity)
 };
 
 // loads: global 3n vector; fixed_node: per node.

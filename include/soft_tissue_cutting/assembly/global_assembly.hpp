@@ -1,4 +1,4 @@
-// Global sparse assembly over a chosen set of tets and DOFs (METHOD.md sections 1-3): the
+// Global sparse assembly over a chosen set of tets and DOFs (docs/DESIGN.md sections 2-4): the
 // same routine builds the full K, K^(1) of the operation part and K^(2) of the condensed part.
 #pragma once
 

@@ -1,4 +1,4 @@
-// External loads and supports of a scene as global per-node data (METHOD.md section 1).
+// External loads and supports of a scene as global per-node data (docs/DESIGN.md section 2).
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"
@@ -10,7 +10,8 @@
 namespace stc {
 
 // Concentrated nodal forces (3n): `force` acts on every selected node, `total_force` is split
-// evenly over the selected nodes (SPEC 3). Selectors are evaluated on scene.mesh.
+// evenly over the selected nodes (docs/SCENE.md "Scene file"). Selectors are evaluated on
+// scene.mesh.
 Vector point_loads(const Scene& scene);
 
 // Consistent body force of gravity for linear tets: each tet gives rho g V / 4 to each of its

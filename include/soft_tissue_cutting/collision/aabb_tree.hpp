@@ -20,7 +20,8 @@ class AabbTree {
   // Primitives whose box overlaps `box` (appended to out, unordered).
   void overlapping(const Box3& box, std::vector<int>& out) const;
   // Primitives whose box the ray origin + s dir, s >= 0, meets.
-  void along_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, std::vector<int>& out) const;
+  void along_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                 std::vector<int>& out) const;
   int size() const { return static_cast<int>(order_.size()); }
 
  private:

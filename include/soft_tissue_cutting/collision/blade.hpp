@@ -1,6 +1,6 @@
-// The scalpel's cutting edge as a segment (SPEC 3 `scalpel`): the pose origin is the tip, the
-// edge runs from the tip along the pose's local +x for blade_length, the blade lies in its
-// local x-z plane, so its normal is the local y axis.
+// The scalpel's cutting edge as a segment (docs/SCENE.md "Scene file", `scalpel`): the pose origin
+// is the tip, the edge runs from the tip along the pose's local +x for blade_length, the blade lies
+// in its local x-z plane, so its normal is the local y axis.
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"
@@ -8,9 +8,9 @@
 namespace stc {
 
 struct BladeEdge {
-  Vec3 tip = Vec3::Zero();             // pose origin
-  Vec3 heel = Vec3::Zero();            // tip + blade_length * local x
-  Vec3 normal = Vec3::UnitY();         // local y, unit
+  Vec3 tip = Vec3::Zero();      // pose origin
+  Vec3 heel = Vec3::Zero();     // tip + blade_length * local x
+  Vec3 normal = Vec3::UnitY();  // local y, unit
 };
 
 BladeEdge blade_edge(const BladePose& pose, double blade_length);

@@ -1,4 +1,4 @@
-// Blade-tissue contact (METHOD 5 steps 2-3), the simplest honest model: the cutting edge is
+// Blade-tissue contact (docs/DESIGN.md section 7), the simplest honest model: the cutting edge is
 // a segment, the tissue surface a triangle mesh at its deformed positions.
 //
 // A surface node of the operation part is TOUCHED when
@@ -30,8 +30,9 @@ struct ContactNode {
 };
 
 struct BladeContact {
-  std::vector<ContactNode> nodes;      // ascending by node
-  std::vector<int> crossed_triangles;  // surface triangles the edge crosses (indices into bvh.surface())
+  std::vector<ContactNode> nodes;  // ascending by node
+  std::vector<int>
+      crossed_triangles;  // surface triangles the edge crosses (indices into bvh.surface())
 };
 
 BladeContact blade_contact(const SurfaceBvh& bvh, const TetMesh& mesh, const BladeEdge& edge,

@@ -1,4 +1,4 @@
-// Contact of the whole blade with the operation-part surface (METHOD 5 steps 2-3): the edge
+// Contact of the whole blade with the operation-part surface (docs/DESIGN.md section 7): the edge
 // from tip to heel, not only the tip. Stateful: it remembers which surface nodes the blade
 // holds from one step to the next. See docs/DESIGN.md (contact).
 //

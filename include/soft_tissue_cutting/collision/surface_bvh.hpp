@@ -18,6 +18,11 @@ class SurfaceBvh {
   // (empty = all). displacement: per node (empty = rest shape).
   void build(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
              const std::vector<Vec3>& displacement);
+  // The same from a boundary surface the caller already has (e.g. updated from the operation
+  // part alone after a cut, simulation/operation_surface.hpp).
+  void build(BoundarySurface surface, const TetMesh& mesh,
+             const std::vector<std::uint8_t>& operation_tets,
+             const std::vector<Vec3>& displacement);
   // Every step (same surface, nodes moved).
   void refit(const TetMesh& mesh, const std::vector<Vec3>& displacement);
 

@@ -1,12 +1,13 @@
-// Contact between the blade tip and the surface of the operation part (METHOD 5 steps 2-3).
+// Contact between the blade tip and the surface of the operation part (docs/DESIGN.md section 7).
 //
 // Model: when the tip first enters the deformed surface of the operation part, the surface
 // triangle it touches is anchored to the tip. While the blade presses, that triangle's three
 // nodes follow the tip from where they were at the touch (each node's displacement at the
 // touch plus the tip's motion since), and the tissue's reaction on the blade is minus the
 // force the solve needs at those nodes. The contact ends when the tip withdraws above the point it
-// first touched (the deformed surface at that moment), along that surface's normal. A pure plunge therefore presses; the blade cuts only once the
-// reaction exceeds `cut_pressure` (SPEC 3).
+// first touched (the deformed surface at that moment), along that surface's normal. A pure plunge
+// therefore presses; the blade cuts only once the reaction exceeds `cut_pressure` (docs/SCENE.md
+// "Scene file").
 #pragma once
 
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
@@ -20,10 +21,10 @@
 namespace stc {
 
 struct ContactAnchor {
-  Tri nodes;            // the touched surface triangle
+  Tri nodes;                               // the touched surface triangle
   std::array<Vec3, 3> touch_displacement;  // the nodes' displacements at the touch
-  Vec3 touch_point;     // where the tip met the deformed surface
-  Vec3 touch_normal;    // outward unit normal of the deformed triangle there
+  Vec3 touch_point;                        // where the tip met the deformed surface
+  Vec3 touch_normal;                       // outward unit normal of the deformed triangle there
 };
 
 // The first contact of `tip` with the surface triangles (deformed positions x + u): the

@@ -38,8 +38,8 @@ struct CutOptions {
   double relocate_min_dihedral_deg = 10.0;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
-  // SPEC 6's "small fraction" is this number. With snap 0.1 a tet can be cut through twice
-  // (0.1^2 = 0.01) before the guard changes any cut.
+  // docs/SCENE.md "Cut invariants": "small fraction" is this number. With snap 0.1 a tet can be cut
+  // through twice (0.1^2 = 0.01) before the guard changes any cut.
   double min_volume_fraction = 0.01;
   // Barycentric slack of "inside the sweep triangle" (crossing points and face centroids),
   // so a cut along a triangle's border and consecutive sweeps leave no gap.

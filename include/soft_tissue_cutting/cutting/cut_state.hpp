@@ -19,7 +19,8 @@ struct CutState {
   std::vector<std::uint8_t> locked;
   // Per tet: part of the operation part; only these are split, cut or separated.
   std::vector<std::uint8_t> cuttable;
-  // Per tet: the volume of the original input tet it descends from (its "size class", SPEC 6).
+  // Per tet: the volume of the original input tet it descends from (its "size class", docs/SCENE.md
+  // "Cut invariants").
   std::vector<double> origin_volume;
   // Per node: the tets that use it (kept up to date by every edit).
   std::vector<std::vector<int>> node_tets;

@@ -1,5 +1,6 @@
 // One cutting step: the surface the blade edge sweeps between two poses, inserted into the
-// operation part of the mesh in place (METHOD 5 step 4), keeping SPEC 6.
+// operation part of the mesh in place (docs/DESIGN.md section 8), keeping docs/SCENE.md "Cut
+// invariants".
 //
 // The sweep between edges (A0, B0) and (A1, B1) (A = tip, B = heel) is a bilinear patch,
 // approximated by the planar triangles (A0, B0, B1) and (A0, B1, A1). Each triangle is

@@ -1,8 +1,8 @@
 // Pieces of tissue a cut has severed from everything that holds the body in place.
 //
-// Policy the simulation applies (SPEC 6: "neither breaks the solver nor disappears
-// silently"): a free piece is KEPT in the mesh and HELD at its current displacement - its
-// nodes are treated as fixed (Dirichlet, value = their displacement when it came free) from
+// Policy the simulation applies (docs/SCENE.md "Cut invariants": "neither breaks the solver nor
+// disappears silently"): a free piece is KEPT in the mesh and HELD at its current displacement -
+// its nodes are treated as fixed (Dirichlet, value = their displacement when it came free) from
 // then on, so K stays positive definite on the remaining free DOF and the piece stays visible
 // where it was. It is never removed and never left singular; the simulation reports it.
 #pragma once

@@ -1,5 +1,5 @@
-// SPEC 6 as a check: what every cut must leave behind. Used by the tests after every sweep
-// and available to the simulation as a debug assertion.
+// docs/SCENE.md "Cut invariants" as a check: what every cut must leave behind. Used by the tests
+// after every sweep and available to the simulation as a debug assertion.
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"

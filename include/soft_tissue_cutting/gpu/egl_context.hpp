@@ -1,4 +1,4 @@
-// Headless OpenGL context through EGL with no window system (METHOD.md section 6: the paper's
+// Headless OpenGL context through EGL with no window system (docs/DESIGN.md section 9: the paper's
 // CG runs in fragment programs; we need a GL context without a display server).
 // Order of attempts: EGL_EXT_device_enumeration + EGL_PLATFORM_DEVICE_EXT over the devices,
 // hardware first and the software device (EGL_MESA_device_software, llvmpipe) last; then the

@@ -1,5 +1,5 @@
-// The whole Jacobi-preconditioned projected CG in float32 on the GPU (METHOD.md section 6,
-// and section 8: the paper ran only the SpMV on the GPU and read back every iteration).
+// The whole Jacobi-preconditioned projected CG in float32 on the GPU (docs/DESIGN.md section 9,
+// and section 1: the paper ran only the SpMV on the GPU and read back every iteration).
 // Here x, r, z, p, q live in textures, dot products are reduction passes, alpha and beta
 // are 1x1 textures computed by shaders; nothing is read back inside iterate().
 // It solves A d = r0 from d = 0 (GlSolver uses it for each iterative-refinement step).
@@ -35,7 +35,7 @@ class GlCg {
   Texture mask_, minv_;
   Texture x_[2], r_[2], p_[2], z_, q_;
   Texture rz_[2], pq_, alpha_, beta_;  // 1x1
-  int cur_ = 0;     // index of the current x, r, p, rz
+  int cur_ = 0;                        // index of the current x, r, p, rz
 };
 
 }  // namespace gpu

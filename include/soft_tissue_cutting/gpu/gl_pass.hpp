@@ -1,5 +1,5 @@
 // One fragment pass = one full-screen quad drawn into a float render target
-// (METHOD.md section 6: "a fragment program run over a quad computes y = A x").
+// (docs/DESIGN.md section 9: "a fragment program run over a quad computes y = A x").
 // Binds programs, input textures and targets (one or several, MRT), counts passes.
 #pragma once
 

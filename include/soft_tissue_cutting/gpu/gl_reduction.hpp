@@ -1,4 +1,4 @@
-// Dot products on the GPU by halving reduction passes (METHOD.md section 6): a first pass
+// Dot products on the GPU by halving reduction passes (docs/DESIGN.md section 9): a first pass
 // multiplies two vectors and sums 2x2 blocks, then 2x2 sums ping-pong down a chain of
 // half-size RG32F textures; the last pass writes a caller-owned 1x1 texture, so the scalar
 // stays on the GPU (alpha and beta are computed from it by shaders).

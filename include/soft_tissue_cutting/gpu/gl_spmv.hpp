@@ -1,4 +1,4 @@
-// The matrix in textures and the fragment-pass SpMV y = A x (METHOD.md section 6), for the
+// The matrix in textures and the fragment-pass SpMV y = A x (docs/DESIGN.md section 9), for the
 // three layouts of matrix_layout.hpp. Needs the owning context current.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Float / integer 2D textures used as GPU arrays (METHOD.md section 6: vectors, Telement,
+// Float / integer 2D textures used as GPU arrays (docs/DESIGN.md section 9: vectors, Telement,
 // Tindex and Tst all live in textures). RAII around one GL texture name; the owning context
 // must be current for every call.
 #pragma once

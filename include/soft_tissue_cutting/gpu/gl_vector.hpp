@@ -1,4 +1,4 @@
-// Vectors as R32F textures (METHOD.md section 6: "vectors are float textures"): entry i at
+// Vectors as R32F textures (docs/DESIGN.md section 9: "vectors are float textures"): entry i at
 // texel (i & (width-1), i >> shift); padding texels hold 0 so reductions may sum them.
 #pragma once
 

@@ -1,5 +1,5 @@
-// CPU-side packing of a symmetric sparse matrix into the texture layouts of METHOD.md
-// section 6. The diagonal is stored apart (its own texture, also used by Jacobi); only the
+// CPU-side packing of a symmetric sparse matrix into the texture layouts of docs/DESIGN.md
+// section 9. The diagonal is stored apart (its own texture, also used by Jacobi); only the
 // off-diagonal non-zeros go into Telement. Every row has one Tindex texel (start, count).
 //
 //  - Method A (paper): one non-zero per Telement texel, value and column packed in one texel
@@ -39,15 +39,15 @@ TextureShape vector_shape(long n, int max_width = 2048, int max_texture_size = 1
 struct PackedMatrix {
   SpmvLayout layout = SpmvLayout::RowLoop;
   int rows = 0;
-  TextureShape vec;                  // vectors, Tindex and the diagonal
-  TextureShape elem;                 // Telement (texels) and the index textures
-  int max_row = 0;                   // longest row, off-diagonal non-zeros
-  int passes = 0;                    // fragment passes per SpMV
-  long stored = 0;                   // Telement texels actually used
-  std::vector<float> diagonal;       // vec.texels(), R32F
-  std::vector<std::int32_t> tindex;  // vec.texels() x (start texel, texel count), RG32I
-  std::vector<std::int32_t> telement_a;  // Method A: elem.texels() x (value bits, column)
-  std::vector<float> telement4;          // B / RowLoop: elem.texels() x 4 values, RGBA32F
+  TextureShape vec;                        // vectors, Tindex and the diagonal
+  TextureShape elem;                       // Telement (texels) and the index textures
+  int max_row = 0;                         // longest row, off-diagonal non-zeros
+  int passes = 0;                          // fragment passes per SpMV
+  long stored = 0;                         // Telement texels actually used
+  std::vector<float> diagonal;             // vec.texels(), R32F
+  std::vector<std::int32_t> tindex;        // vec.texels() x (start texel, texel count), RG32I
+  std::vector<std::int32_t> telement_a;    // Method A: elem.texels() x (value bits, column)
+  std::vector<float> telement4;            // B / RowLoop: elem.texels() x 4 values, RGBA32F
   std::vector<std::int32_t> tst_a, tst_b;  // B: elem.texels() x (s0, t0, s1, t1) / (s2, t2, s3, t3)
   std::vector<std::int32_t> tcols;         // RowLoop: elem.texels() x 4 columns, RGBA32I
 };

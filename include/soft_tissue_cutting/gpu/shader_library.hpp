@@ -1,4 +1,4 @@
-// GLSL programs of the texture CG (METHOD.md section 6: "a fragment program run over a quad").
+// GLSL programs of the texture CG (docs/DESIGN.md section 9: "a fragment program run over a quad").
 // Sources live in shaders/*.glsl without a #version line; the library prepends the one that
 // fits the context (desktop "430 core" or GLES "320 es" + precision), so one file serves both.
 // Search order for the folder: $TISSUE_SHADER_DIR, TISSUE_SOURCE_SHADER_DIR (build tree),

@@ -1,4 +1,4 @@
-// Synthetic SPD matrices shaped like the hybrid system of METHOD.md section 3, for the GPU
+// Synthetic SPD matrices shaped like the hybrid system of docs/DESIGN.md section 4, for the GPU
 // tests and bench/bench_gpu.cpp (the paper's Table 2, section 7): a sparse 3D-elasticity-like
 // part (3 DOF per node, 7-point node stencil, 3x3 blocks: kron(Poisson, B) with B SPD) plus a
 // dense "interface" block (the condensed K0 couples all interface DOFs).

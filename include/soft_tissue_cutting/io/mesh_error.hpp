@@ -1,4 +1,5 @@
-// The one exception type of mesh input/output (SPEC 3: one clear line naming file and line).
+// The one exception type of mesh input/output (docs/SCENE.md "Meshes": one clear line naming file
+// and line).
 #pragma once
 
 #include <stdexcept>

@@ -1,4 +1,4 @@
-// Reading tetrahedral meshes (SPEC 3 `mesh.file`): Gmsh, TetGen, VTK legacy, VTK XML, and
+// Reading tetrahedral meshes (docs/SCENE.md "Meshes"): Gmsh, TetGen, VTK legacy, VTK XML, and
 // closed surfaces tetrahedralized with the TetGen library.
 #pragma once
 
@@ -34,9 +34,9 @@ struct MeshLines {
   std::vector<int> tet_line;
 };
 
-// The checks of SPEC 3 on a mesh from any source: finite coordinates, indices in range, four
-// distinct nodes per tet, no zero-volume tet, one orientation (all negative: flipped with a
-// warning; mixed: refused), no face shared by more than two tets or by two tets on the same
+// The checks of docs/SCENE.md "Meshes" on a mesh from any source: finite coordinates, indices in
+// range, four distinct nodes per tet, no zero-volume tet, one orientation (all negative: flipped
+// with a warning; mixed: refused), no face shared by more than two tets or by two tets on the same
 // side (via extract_boundary_surface), at least one tet. Unreferenced nodes are kept with a
 // warning. `path` prefixes messages; `lines` (optional) adds line numbers.
 void validate_tet_mesh(TetMesh& mesh, const std::string& path,

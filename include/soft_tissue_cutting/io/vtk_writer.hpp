@@ -1,4 +1,5 @@
-// Writing a mesh state as VTK legacy ASCII UNSTRUCTURED_GRID (SPEC 4, contract).
+// Writing a mesh state as VTK legacy ASCII UNSTRUCTURED_GRID (docs/SCENE.md "Offline run", a
+// contract).
 #pragma once
 
 #include "soft_tissue_cutting/io/mesh_error.hpp"

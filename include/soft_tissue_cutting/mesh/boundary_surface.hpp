@@ -6,10 +6,10 @@
 namespace stc {
 
 struct BoundaryTriangle {
-  Tri nodes;     // outward winding (right-hand rule normal points out of the tissue)
-  int tet;       // the tet that owns the face
-  int face;      // its local face index (see kTetFaces)
-  bool cut;      // lies on a cut surface
+  Tri nodes;  // outward winding (right-hand rule normal points out of the tissue)
+  int tet;    // the tet that owns the face
+  int face;   // its local face index (see kTetFaces)
+  bool cut;   // lies on a cut surface
 };
 
 struct BoundarySurface {

@@ -1,4 +1,4 @@
-// The linear tetrahedral mesh every pipeline stage works on (METHOD.md section 1).
+// The linear tetrahedral mesh every pipeline stage works on (docs/DESIGN.md section 2).
 #pragma once
 
 #include <Eigen/Core>

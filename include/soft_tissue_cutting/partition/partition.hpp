@@ -1,4 +1,4 @@
-// Operation part / non-operation part and the node sets O, I, S, Q (METHOD.md section 2).
+// Operation part / non-operation part and the node sets O, I, S, Q (docs/DESIGN.md section 3).
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"
@@ -35,5 +35,13 @@ Partition partition_mesh(const TetMesh& mesh, const OperationRegion& region);
 
 // Node sets from a given per-tet labelling (S uses extract_boundary_surface).
 Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> operation_tet);
+
+// The partition after a change of the operation part only (a cut): `changed_tets` (replaced
+// or appended) become part-1 tets, appended nodes join O. Part 2 is untouched, so S and Q
+// stay as they are and only the part-1 tets are scanned (no boundary extraction of the whole
+// mesh). Returns false if the change reached part 2 (a changed tet was a part-2 tet, or an
+// interface node stopped being shared): the caller refuses the change.
+bool update_partition_for_operation_change(const TetMesh& mesh,
+                                           const std::vector<int>& changed_tets, Partition& p);
 
 }  // namespace stc

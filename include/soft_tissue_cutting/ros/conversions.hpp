@@ -17,13 +17,15 @@ namespace ros_io {
 BladePose to_blade_pose(const geometry_msgs::Pose& pose, double t);
 geometry_msgs::Pose to_pose_msg(const BladePose& pose);
 
-// True when every component is finite and the quaternion is not (near) zero.
-bool is_finite_pose(const geometry_msgs::Pose& pose);
+// Why `pose` cannot be a blade pose: "not finite (NaN/Inf)", "zero quaternion", or "" when it
+// can. One check for the topic, tf2 and ~cut inputs.
+std::string pose_problem(const geometry_msgs::Pose& pose);
+std::string pose_problem(const BladePose& pose);
 
 // One step's SimStats: StepStats + sizes of the current state + backend in use.
 soft_tissue_cutting::SimStats to_stats_msg(const StepStats& step, const ModelCounts& counts,
-                                           const std::string& backend,
-                                           const std::string& renderer, double rate_hz);
+                                           const std::string& backend, const std::string& renderer,
+                                           double rate_hz);
 
 // Force and torque about the blade tip on the blade; in the tissue frame, or in the blade's
 // axes (x along the edge, y its normal) when `blade_axes` gives the blade pose.

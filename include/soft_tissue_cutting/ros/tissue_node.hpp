@@ -1,13 +1,23 @@
-// tissue_node: the ROS 1 face of the simulation (SPEC section 5). Thin: all physics is in
-// stc::Simulation; this class owns the loop thread, the topics, services and parameters.
+// tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). Thin: all physics is in
+// stc::Simulation; this class owns the threads, the topics, services and parameters. One file
+// per job (src/ros/): tissue_node.cpp wiring, node_params.cpp parameters, scalpel_input.cpp
+// topic/tf2 poses, simulation_loop.cpp the loop (and ~cut slices), node_publishing.cpp
+// messages, node_services.cpp services, node_diagnostics.cpp /diagnostics. Message building
+// that needs no master is in the tissue_ros library (conversions, markers, pose_input,
+// loop_monitor, log_text).
 //
-// Threads: the simulation loop runs in its own std::thread at ~rate; ROS callbacks (pose
-// input, services, dynamic_reconfigure) run on an AsyncSpinner. `sim_mutex_` guards the
-// Simulation; the pose callback only touches PoseInput (its own mutex), so it never waits for
-// a step. Surface and marker messages are published while holding `sim_mutex_`, so their
-// order on the wire is the order of the states they show.
+// Threads (docs/ROS.md (threads)): the simulation loop runs in its own std::thread at ~rate;
+// ROS callbacks (pose input, services, dynamic_reconfigure) run on an AsyncSpinner; a third
+// thread publishes /diagnostics from LoopMonitor without ever taking `sim_mutex_`, so a busy
+// simulation is still reported. `sim_mutex_` guards the Simulation and is held for one step
+// (or one ~cut slice) at a time: ~cut queues its path for the loop, ~reset builds the fresh
+// Simulation outside the lock and swaps it in, ~save copies the state and writes outside it.
+// Surface and marker messages are published while holding `sim_mutex_`, so their order on
+// the wire is the order of the states they show.
 #pragma once
 
+#include "soft_tissue_cutting/ros/loop_monitor.hpp"
+#include "soft_tissue_cutting/ros/node_params.hpp"
 #include "soft_tissue_cutting/ros/pose_input.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
@@ -26,6 +36,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -36,67 +48,75 @@
 namespace stc {
 namespace ros_io {
 
-struct NodeParams {
-  std::string scene = "thigh";
-  std::string frame_id = "tissue";
-  double rate = 100.0;
-  std::string scalpel_frame;  // empty: poses come from the scalpel/pose topic
-  std::string backend;        // empty: the scene's solver.backend
-  double max_pose_jump = 0.05;  // m
-  double display_rate = 30.0;   // Hz, upper limit for ~surface / ~markers
-  // If set, the node publishes ~frame_id as a static tf child of this frame (placed by
-  // parent_transform: x y z qx qy qz qw), so the tissue sits in a robot's tf tree and rviz
-  // has its fixed frame. Empty: someone else publishes ~frame_id.
-  std::string parent_frame;
-  std::vector<double> parent_transform = {0, 0, 0, 0, 0, 0, 1};
-  // ~scalpel/wrench axes: "tissue" (~frame_id) or "blade" (x along the edge, y the blade
-  // normal, z = x cross y; header frame ~scalpel_frame, or "scalpel" without one). The torque
-  // is about the blade tip either way.
-  std::string wrench_frame = "tissue";
-};
-
-// Reads the private parameters; throws std::runtime_error naming a bad one.
-NodeParams read_params(const ros::NodeHandle& pnh);
-
-// The scene named by ~scene: "thigh" or a YAML path. Throws std::runtime_error with a
-// one-line reason naming the file.
-Scene load_scene_param(const std::string& scene);
-
 class TissueNode {
  public:
-  TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams params,
-             std::unique_ptr<Simulation> sim);
+  TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams params, Scene scene,
+             SimulationOptions options, std::unique_ptr<Simulation> sim);
   ~TissueNode();
   TissueNode(const TissueNode&) = delete;
   TissueNode& operator=(const TissueNode&) = delete;
 
-  void start();  // publishes the initial state, starts the loop thread
-  void stop();   // joins the loop thread
+  void start();  // publishes the initial state, starts the loop and diagnostics threads
+  void stop();   // joins them; queued ~cut requests are answered
 
  private:
-  void loop();
+  // A ~cut request waiting for (or being inserted by) the loop.
+  struct CutJob {
+    std::vector<BladePose> poses;  // scene frame, as requested
+    PathCut path;                  // begun by the loop
+    bool begun = false;
+    bool finished = false;
+    CutOutcome outcome;
+  };
+
+  // wiring (tissue_node.cpp)
+  void publish_trajectory_param();
+  void publish_parent_frame();
+  PoseGateSettings pose_gate_settings() const;
+
+  // scalpel input (scalpel_input.cpp)
   std::optional<BladePose> current_blade();  // topic or tf2 input, gated
   bool to_scene_frame(const geometry_msgs::PoseStamped& in, geometry_msgs::Pose* out,
                       std::string* why) const;
   void on_pose(const geometry_msgs::PoseStamped::ConstPtr& msg);
-  // Publish ~surface, ~markers and ~mesh_hash from the current state. Caller holds sim_mutex_.
+  void offer_pose(const geometry_msgs::Pose& pose, const char* source);
+
+  // the loop (simulation_loop.cpp)
+  void loop();
+  void advance_cut_locked(LoopMonitor::Clock::time_point deadline);
+  void finish_cut_locked(const StepStats& step);
+  void answer_cuts(std::deque<std::shared_ptr<CutJob>> jobs, const std::string& why);
+
+  // publishing (node_publishing.cpp). Callers hold sim_mutex_.
+  void publish_step_locked(const StepStats& s, const std::optional<BladePose>& blade,
+                           const ros::Time& stamp, double rate_hz);
+  // The last non-converged solve's reason, for /diagnostics (under info_mutex_).
+  void remember_solver_failure(const std::string& why);
+  void publish_display_locked(const StepStats& s, const ros::Time& stamp);
   void publish_surface_locked(const ros::Time& stamp);
   void publish_markers_locked(const ros::Time& stamp, const DeformedSurface* surface = nullptr);
 
+  // services (node_services.cpp)
   bool on_cut(soft_tissue_cutting::Cut::Request& req, soft_tissue_cutting::Cut::Response& res);
   bool on_reset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool on_set_cutting(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
   bool on_save(soft_tissue_cutting::SaveMesh::Request& req,
                soft_tissue_cutting::SaveMesh::Response& res);
   void on_reconfigure(soft_tissue_cutting::TissueConfig& config, uint32_t level);
+
+  // diagnostics (node_diagnostics.cpp)
+  void diagnostics_thread();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  void publish_trajectory_param();
+  void remember_backend_locked();
 
   ros::NodeHandle nh_, pnh_;
-  NodeParams params_;
+  const NodeParams params_;
+  const Scene initial_scene_;  // ~reset builds a fresh Simulation from it
+  const SimulationOptions options_;
   std::unique_ptr<Simulation> sim_;
   std::mutex sim_mutex_;
   PoseInput pose_input_;
+  LoopMonitor monitor_;
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
@@ -111,18 +131,30 @@ class TissueNode {
   std::unique_ptr<dynamic_reconfigure::Server<soft_tissue_cutting::TissueConfig>> reconfigure_;
   diagnostic_updater::Updater diagnostics_;
 
-  std::thread thread_;
+  std::thread thread_, diagnostics_thread_;
   std::atomic<bool> running_{false};
   std::chrono::steady_clock::time_point started_;
 
-  // Loop bookkeeping (loop thread; read by diagnostics under stats_mutex_).
-  std::mutex stats_mutex_;
-  double achieved_rate_ = 0;
-  bool last_converged_ = true;
-  std::uint64_t steps_ = 0;
+  // ~cut requests: queued by on_cut, taken by the loop (under cut_mutex_); the job in progress
+  // is touched only under sim_mutex_. cut_done_ wakes the waiting service calls.
+  std::mutex cut_mutex_;
+  std::condition_variable cut_done_;
+  std::deque<std::shared_ptr<CutJob>> queued_cuts_;
+  int cuts_waiting_ = 0;  // service calls waiting for their cut (queued or in progress)
+  std::shared_ptr<CutJob> active_cut_;               // under sim_mutex_
+  LoopMonitor::Clock::time_point next_cut_slice_{};  // under sim_mutex_
+
+  // What /diagnostics says about the backend: copied under sim_mutex_, read under info_mutex_.
+  std::mutex info_mutex_;
+  std::string backend_, renderer_, backend_note_;
+  std::string solver_failure_;               // why the last non-converged solve failed
+  std::string solved_by_, fallback_reason_;  // the last step's (cpu when a gl solve fell back)
+  std::uint64_t steps_ = 0;                  // loop thread
 
   // Display bookkeeping (under sim_mutex_).
   std::uint64_t published_version_ = 0;
+  // surface versions restart with each fresh Simulation: ~reset bumps sim_generation_.
+  std::uint64_t sim_generation_ = 0, published_generation_ = ~std::uint64_t{0};
   bool published_any_ = false;
   ros::WallTime last_surface_pub_, last_markers_pub_;
   std::string last_hash_;

@@ -1,4 +1,4 @@
-// The scene of SPEC.md section 3, as data. Loading and validation: scene_loader.hpp.
+// The scene of docs/SCENE.md "Scene file", as data. Loading and validation: scene_loader.hpp.
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
@@ -72,13 +72,13 @@ struct SolverParams {
   int max_iterations = 2000;
 };
 
-// Parameters of the built-in generators (SPEC 3 `mesh.generator`).
+// Parameters of the built-in generators (docs/SCENE.md "Scene file", `mesh.generator`).
 struct GeneratorParams {
   std::string type;  // "thigh" or "box"
   // thigh: a thick tube along z; the inner wall is the removed thighbone.
   double inner_radius = 0.015;
   double outer_radius = 0.06;
-  double length = 0.096;  // 8 cells of 12 mm: near-cubic cells at the default resolution
+  double length = 0.096;    // 8 cells of 12 mm: near-cubic cells at the default resolution
   double resolution = 1.0;  // multiplies the number of cells along each direction
   // box
   Vec3 size = Vec3(0.1, 0.02, 0.02);
@@ -86,11 +86,11 @@ struct GeneratorParams {
 };
 
 struct Scene {
-  std::string source;         // file path the scene came from, or "thigh"
-  std::string mesh_file;      // resolved path, empty when generated
+  std::string source;     // file path the scene came from, or "thigh"
+  std::string mesh_file;  // resolved path, empty when generated
   std::optional<GeneratorParams> generator;
   double scale = 1.0;
-  TetMesh mesh;               // loaded/generated, scaled
+  TetMesh mesh;  // loaded/generated, scaled
   Material material;
   std::vector<NodeSelector> fixed;
   std::vector<Load> loads;

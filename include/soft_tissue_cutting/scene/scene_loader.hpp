@@ -1,4 +1,4 @@
-// Loading and validating a scene file (SPEC 3, contract).
+// Loading and validating a scene file (docs/SCENE.md "Scene file", a contract).
 #pragma once
 
 #include "soft_tissue_cutting/scene/scene.hpp"

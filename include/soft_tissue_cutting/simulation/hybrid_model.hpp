@@ -1,9 +1,11 @@
-// The hybrid condensed finite element model (METHOD.md sections 2-4): the operation part
+// The hybrid condensed finite element model (docs/DESIGN.md sections 3-5): the operation part
 // (part 1) stays a sparse FE model that cutting may change; the non-operation part (part 2) is
-// condensed once onto the interface. Each step solves eq. 17 over the free DOFs of O u I,
+// condensed once onto the interface. Each step solves docs/DESIGN.md eq. (10) (the paper's eq. 17)
+// over the free DOFs of O u I,
 //   [K1_OO  K1_OI     ] [u_O]   [f_O     ]
 //   [K1_IO  K1_II + K0] [u_I] = [f_I - g0]
-// with the injectable LinearSolver (projected CG, warm-started), then recovers u_S = c_S + R u_I.
+// with the injectable LinearSolver (projected CG, warm-started). The condensed part's
+// displacements u_S, u_Q follow from u_I through the kept factor of K2_NN, on demand.
 // ROS-free; the Simulation facade drives it.
 #pragma once
 
@@ -26,7 +28,7 @@ namespace stc {
 // Imposed displacements: node -> displacement (scalpel contact, held free pieces).
 using ImposedDisplacements = std::map<int, Vec3>;
 
-// Sizes for the stats (SPEC section 4); fixed nodes count in their set.
+// Sizes for the stats (docs/SCENE.md "Offline run"); fixed nodes count in their set.
 struct HybridModelCounts {
   int nodes = 0, tets = 0;
   int dof_operation = 0;  // rows of the hybrid system: free DOFs of O u I
@@ -45,8 +47,10 @@ class HybridModel {
   HybridModel& operator=(const HybridModel&) = delete;
 
   // One quasi-static step: the imposed DOFs become constrained DOFs of the projected CG, warm
-  // started from the current displacement; then u_S is recovered. Imposed nodes must be O or
-  // I nodes (std::invalid_argument otherwise); imposed components on fixed nodes are ignored.
+  // started from the current displacement. Imposed nodes must be O or I nodes
+  // (std::invalid_argument otherwise); imposed components on fixed nodes are ignored. With
+  // the system and the imposed displacements unchanged since the last solve, the last
+  // solution is returned at once (0 iterations): it is still exact.
   CgResult solve(const ImposedDisplacements& imposed = {});
 
   // Sum over `nodes` of (K u - f) of the whole model at the current solution: the force the
@@ -55,18 +59,26 @@ class HybridModel {
   // exactly part 2's K2_II u_I + K2_IN u_N - f2_I). Fixed DOFs and S/Q nodes contribute 0.
   Vec3 reaction_force(const std::vector<int>& nodes) const;
 
-  // 3n displacement. O, I, S are current after solve(); Q after recover_interior().
-  const Vector& displacement() const { return u_; }
+  // 3n displacement, every node current: O and I from the last solve, S and Q recovered
+  // from u_I through the factor of K2_NN when u_I moved since the last recovery (one sparse
+  // solve, at the rate the caller asks: display, output).
+  const Vector& displacement() const;
+  // O and I current; S and Q as last recovered (the per-step contact and cutting use this).
+  const Vector& operation_displacement() const { return u_; }
+  // Kept for callers of the former two-stage recovery: displacement() recovers Q too.
   void recover_interior();
+  // How many recoveries of u_S, u_Q ran (for tests and benchmarks).
+  long recoveries() const { return recoveries_; }
   // Zero displacement everywhere (the next solve starts cold).
-  void reset_displacement() { u_.setZero(); }
+  void reset_displacement();
 
   // Cutting hook: the operation part of mesh_for_cutting() was changed in place (tets
   // replaced or appended, nodes appended). changed_tets: indices of replaced and new tets
   // (all become operation tets); new_nodes: one entry per appended node, in order (all become
   // O nodes, unloaded; an edge node starts at (1 - t) u_a + t u_b and is fixed only if both
-  // ends are; a duplicate starts at u_a and keeps a's fixed flag). Only the changed element matrices are recomputed; K0, g0, R,
-  // c_S are untouched. Consistent gravity of the changed tets is re-lumped.
+  // ends are; a duplicate starts at u_a and keeps a's fixed flag). Only the changed element
+  // matrices are recomputed; K0, g0, R, c_S are untouched. Consistent gravity of the changed tets
+  // is re-lumped.
   void update_operation_part(const std::vector<int>& changed_tets,
                              const std::vector<NewNode>& new_nodes);
   TetMesh& mesh_for_cutting() { return mesh_; }
@@ -77,7 +89,11 @@ class HybridModel {
 
   void set_solver(std::unique_ptr<LinearSolver> solver);
   const LinearSolver& solver() const { return *solver_; }
-  void set_cg_settings(const CgSettings& settings) { settings_ = settings; }
+  // New settings: the next solve runs even if nothing else changed (a tighter tolerance).
+  void set_cg_settings(const CgSettings& settings) {
+    settings_ = settings;
+    system_changed_ = true;
+  }
   const CgSettings& cg_settings() const { return settings_; }
 
   const TetMesh& mesh() const { return mesh_; }
@@ -86,11 +102,11 @@ class HybridModel {
   HybridModelCounts counts() const;
   const CgResult& last_result() const { return last_; }
   // Precompute stages in ms: partition, element_stiffness, condensation_assembly,
-  // condensation_factor, condensation_solve, condensation_products, recovery_operator,
-  // hybrid_assembly, total.
+  // condensation_factor, condensation_solve, condensation_products, hybrid_assembly, total.
   const std::map<std::string, double>& precompute_timings_ms() const { return timings_; }
 
-  // The assembled eq. 17 system and its DOF numbering (for tests and GPU backends).
+  // The assembled hybrid system (docs/DESIGN.md eq. (10)) and its DOF numbering (for tests and GPU
+  // backends).
   const SparseMatrix& hybrid_matrix() const { return a_; }
   const Vector& hybrid_rhs() const { return b_; }
   const DofMap& hybrid_dofs() const { return dofs_; }
@@ -100,22 +116,27 @@ class HybridModel {
 
  private:
   void rebuild_hybrid_system();
-  void recover_surface();
 
   TetMesh mesh_;
   Vec3 gravity_ = Vec3::Zero();
-  Vector point_loads_;                  // 3n, new nodes unloaded
-  std::vector<std::uint8_t> fixed_;     // per node
+  Vector point_loads_;               // 3n, new nodes unloaded
+  std::vector<std::uint8_t> fixed_;  // per node
   ElementStiffnessCache elements_;
   Partition partition_;
   CondensedPart condensed_;
-  SurfaceRecovery recovery_;
-  double condensed_scale_ = 1.0;        // E now / E at condensation time
-  DofMap dofs_;                         // hybrid system over free DOFs of O u I
-  std::vector<int> interface_row_;      // free interface DOF k -> hybrid row
+  double condensed_scale_ = 1.0;    // E now / E at condensation time
+  DofMap dofs_;                     // hybrid system over free DOFs of O u I
+  std::vector<int> interface_row_;  // free interface DOF k -> hybrid row
   SparseMatrix a_;
+  SparseMatrix k0_padded_;  // K0 as a sparse block (3|I|_free square), see rebuild
   Vector b_;
-  Vector u_;
+  // u_ is mutable for the on-demand recovery of its S and Q entries in displacement().
+  mutable Vector u_;
+  mutable Vector recovered_from_;        // u_I the S and Q entries were recovered from
+  mutable bool condensed_stale_ = true;  // u_I moved since then
+  mutable long recoveries_ = 0;
+  bool system_changed_ = true;  // matrix, rhs or u_ changed since the last solve
+  ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;
   CgSettings settings_;
   CgResult last_;

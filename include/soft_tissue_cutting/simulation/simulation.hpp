@@ -1,4 +1,4 @@
-// One simulated surgical scene: the per-step pipeline of METHOD.md section 5 (collision,
+// One simulated surgical scene: the per-step pipeline of docs/DESIGN.md section 10 (collision,
 // contact, cutting, hybrid solve, surface recovery) behind a ROS-free facade. The ROS node
 // and the offline `./tissue solve` both drive this class.
 #pragma once
@@ -6,6 +6,7 @@
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -16,6 +17,7 @@
 namespace stc {
 
 class HybridModel;
+struct StepTimes;  // simulation/step_times.hpp
 
 struct SimulationOptions {
   std::string backend;  // "" = the scene's solver.backend; "cpu" or "gl"
@@ -25,27 +27,34 @@ struct SimulationOptions {
 struct StepStats {
   std::uint64_t step = 0;
   bool in_contact = false;
-  bool cutting = false;          // this step inserted a cut
-  Vec3 contact_force = Vec3::Zero();  // N, reaction of the tissue on the blade (scene frame)
+  bool cutting = false;                // this step inserted a cut
+  Vec3 contact_force = Vec3::Zero();   // N, reaction of the tissue on the blade (scene frame)
   Vec3 contact_torque = Vec3::Zero();  // N m, its moment about the blade tip (scene frame)
   std::vector<int> contact_nodes;      // the nodes the blade holds this step, ascending
   std::vector<Vec3> contact_points;    // where it holds them (deformed, scene frame)
   int cg_iterations = 0;
   double residual = 0;
   bool converged = true;
-  int tets_split = 0;   // this step
-  int nodes_added = 0;  // this step
+  // The backend that solved this step ("cpu" or "gl"; empty: nothing to solve). A gl solve
+  // that float32 could not finish is completed on the cpu: solved_by "cpu" and
+  // fallback_reason says why in one line.
+  std::string solved_by;
+  std::string fallback_reason;
+  std::string solver_message;      // one line when !converged: why the solve stopped short
+  int tets_split = 0;              // this step
+  int nodes_added = 0;             // this step
   bool reached_interface = false;  // the blade tried to cut into the condensed part
   double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0, recovery_ms = 0;
   double step_ms = 0;
 };
 
-// Sizes of the current state (after cuts), as SPEC section 4 names them.
+// Sizes of the current state (after cuts), as docs/SCENE.md "Offline run" names them.
 struct ModelCounts {
   int nodes = 0, tets = 0, dof_operation = 0, nodes_interface = 0;
   int nodes_surface_condensed = 0, nodes_interior_condensed = 0;
   int cuts = 0, tets_split = 0, free_pieces_held = 0;
   long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
+  long solver_fallbacks = 0;     // gl solves finished on the cpu since the start (or reset)
   double volume_initial = 0, volume_final = 0;
 };
 
@@ -55,11 +64,26 @@ struct CutOutcome {
   int tets_split = 0, nodes_added = 0, cut_faces = 0;
 };
 
+// A cut path being inserted a slice at a time (begin_path_cut, cut_path_slice,
+// finish_path_cut), so a caller can keep stepping between the slices of a long path; the ROS
+// node does, and cut_along() is the three in one go plus a solve.
+struct PathCut {
+  std::string refusal;           // set: the path was refused (done() at once)
+  std::vector<BladePose> poses;  // the path resampled at a fixed spacing (cutting/blade_path)
+  std::size_t next = 1;          // the next sweep is poses[next - 1] -> poses[next]
+  int faces_before = 0;
+  int tets_split = 0, nodes_added = 0;
+  bool changed = false;            // some sweep changed the mesh
+  bool crossed = false;            // some pose of the blade edge lay in the operation part
+  bool reached_interface = false;  // cut faces dropped at the interface of the condensed part
+  bool done() const { return !refusal.empty() || next >= poses.size(); }
+};
+
 // The visible deformed surface: operation-part surface including cut faces, plus the
-// condensed surface S (METHOD 5 step 6).
+// condensed surface S (docs/DESIGN.md eq. (12)).
 struct DeformedSurface {
-  std::vector<Vec3> positions;        // deformed position of every mesh node
-  std::vector<double> displacement;   // |u| per node, m
+  std::vector<Vec3> positions;       // deformed position of every mesh node
+  std::vector<double> displacement;  // |u| per node, m
   std::vector<BoundaryTriangle> triangles;
 };
 
@@ -70,10 +94,21 @@ class Simulation {
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 
-  // One step of METHOD 5 with the blade at `blade` (scene frame), or no scalpel.
+  // One step of docs/DESIGN.md section 10 with the blade at `blade` (scene frame), or no scalpel.
   StepStats step(const std::optional<BladePose>& blade);
   // Cut along consecutive poses regardless of cut_pressure (the ~cut service), then solve.
   CutOutcome cut_along(const std::vector<BladePose>& poses);
+  // Validates (>= 2 finite poses) and resamples the path; a refused path comes back done()
+  // with `refusal` set.
+  PathCut begin_path_cut(const std::vector<BladePose>& poses) const;
+  // Inserts the next sweeps of `cut` until `deadline` (at least one); no solve, so the next
+  // step() (or cut_along's solve) brings the displacements to the new mesh.
+  void cut_path_slice(PathCut& cut, std::chrono::steady_clock::time_point deadline);
+  // Counts of the finished (or refused) cut and the true reason when nothing was cut.
+  CutOutcome finish_path_cut(const PathCut& cut) const;
+  // Spacing (m) at which cut paths are resampled: the median edge of the initial operation
+  // part.
+  double cut_path_spacing() const;
   // Back to the initial mesh and state, identical to a fresh start.
   void reset();
 
@@ -89,23 +124,28 @@ class Simulation {
   std::uint64_t surface_version() const;  // changes whenever the drawn surface changes
   ModelCounts counts() const;
   const StepStats& last_stats() const;
-  std::string backend() const;   // solver actually in use: "cpu" or "gl"
-  std::string renderer() const;  // GL renderer for "gl"
-  std::string backend_note() const;  // why gl fell back to cpu, if it did
+  std::string backend() const;                    // solver actually in use: "cpu" or "gl"
+  std::string renderer() const;                   // GL renderer for "gl"
+  std::string backend_note() const;               // why gl fell back to cpu, if it did
+  std::string backend_requested() const;          // "cpu" or "gl": the option, else the scene's
   std::vector<std::uint8_t> tet_regions() const;  // 1 = operation part, per tet
-  std::vector<BladePose> blade_path() const;       // poses of the current scalpel stroke
+  std::vector<BladePose> blade_path() const;      // poses of the current scalpel stroke
 
   // Full displacement (3 x nodes), interior condensed nodes recovered (for output).
   Eigen::VectorXd full_displacement();
-  // SPEC section 4 outputs. Throw std::runtime_error with a one-line reason.
+  // docs/SCENE.md "Offline run" outputs. Throw std::runtime_error with a one-line reason.
   void write_vtk(const std::string& path);
-  void write_stats_json(const std::string& path, double total_ms);
-  std::string stats_json(double total_ms);
+  // `steps`: the step times for `step_ms`; nullptr = every step since the start (or reset).
+  void write_stats_json(const std::string& path, double total_ms, const StepTimes* steps = nullptr);
+  std::string stats_json(double total_ms, const StepTimes* steps = nullptr);
+  // Wall time of every step() since the start (or the last reset), by kind.
+  const StepTimes& step_times() const;
   // Precompute stage timings of the condensation (ms), as the hybrid model measured them.
   const std::map<std::string, double>& precompute_timings_ms() const;
   // The hybrid model behind the simulation (read-only: for tests and analysis).
   const HybridModel& model() const;
-  // Per tet: the volume of the input tet it descends from (its size class, SPEC 6).
+  // Per tet: the volume of the input tet it descends from (its size class, docs/SCENE.md "Cut
+  // invariants").
   const std::vector<double>& tet_size_classes() const;
   // Hash of the current mesh topology and rest positions (replays must agree).
   std::string mesh_hash() const;

@@ -1,4 +1,4 @@
-// The linear solver behind the hybrid system (METHOD.md section 3, eq. 17; section 5 step 5):
+// The linear solver behind the hybrid system (docs/DESIGN.md eq. (10), section 6):
 // a symmetric positive definite sparse matrix solved by Conjugate Gradient, warm-started.
 // Backends: CPU (solve/) and GPU textures through headless EGL (gpu/).
 #pragma once
@@ -17,15 +17,26 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using Vector = Eigen::VectorXd;
 
 struct CgSettings {
-  double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (SPEC 3 solver.tolerance)
+  double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (docs/SCENE.md "Scene file",
+                             // `solver.tolerance`)
   int max_iterations = 2000;
 };
 
 struct CgResult {
-  int iterations = 0;
+  int iterations = 0;   // every CG iteration of this solve, fallback included
   double residual = 0;  // final relative residual ||b - A x|| / ||b|| (true residual)
   bool converged = false;
+  // The backend that produced x: "cpu" or "gl". A gl solve that float32 could not finish is
+  // completed by the CPU solver: then solved_by is "cpu" and fallback_reason says why (one
+  // line). Empty solved_by: nothing was solved (no free DOFs).
+  std::string solved_by;
+  std::string fallback_reason;
+  // One line when !converged: why the solve stopped short of the tolerance.
+  std::string message;
 };
+
+// The one-line reason of a solve that used up max_iterations (both backends).
+std::string iteration_cap_message(const CgResult& result, const CgSettings& settings);
 
 // Solves A x = b with some DOFs held at the values x already has on entry (Dirichlet:
 // contact-imposed displacements, held free pieces): those DOFs have constrained[i] != 0 and
@@ -34,7 +45,7 @@ struct CgResult {
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
-  virtual std::string backend() const = 0;          // "cpu" or "gl"
+  virtual std::string backend() const = 0;             // "cpu" or "gl"
   virtual std::string renderer() const { return ""; }  // GL renderer string for "gl"
   // The preconditioner in use for the current matrix ("jacobi", "cholesky", ...); it may
   // differ from the one asked for when set_matrix had to fall back. Empty if not reported.

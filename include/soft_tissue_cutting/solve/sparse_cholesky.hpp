@@ -1,5 +1,5 @@
 // Sparse Cholesky factorization of an SPD matrix through CHOLMOD's supernodal LL^T
-// (SuiteSparse). Used once per session for K2_NN of the condensed part (METHOD.md section 3)
+// (SuiteSparse). Used once per session for K2_NN of the condensed part (docs/DESIGN.md section 4)
 // and by the reference direct solver of the full model. The CHOLMOD headers stay inside one
 // translation unit (pimpl).
 #pragma once

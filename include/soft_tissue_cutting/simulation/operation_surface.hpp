@@ -1,0 +1,36 @@
+// The tissue's boundary surface after cuts, from the operation part alone (docs/DESIGN.md,
+// per-step cost). Cuts change part 1 only, so the boundary triangles of part-2 tets and the
+// faces shared by the two parts are kept from one whole-mesh extraction; after a cut only the
+// part-1 tets (a few thousand at organ scale, of 70k+) are scanned again.
+#pragma once
+
+#include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace stc {
+
+class OperationSurface {
+ public:
+  // One whole-mesh extraction: operation_tet per tet, nonzero = part 1.
+  void init(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tet);
+  // The whole boundary surface now (same triangles as extract_boundary_surface(mesh), part-2
+  // triangles first). operation_tets: the part-1 tet list.
+  BoundarySurface current(const TetMesh& mesh, const std::vector<int>& operation_tets) const;
+
+ private:
+  // Boundary of the part-1 tets alone, tet indices mapped back to the mesh.
+  static BoundarySurface part1_boundary(const TetMesh& mesh, const std::vector<int>& tets);
+
+  std::vector<BoundaryTriangle> condensed_;  // boundary triangles owned by part-2 tets
+  std::vector<std::array<int, 3>> shared_;   // sorted node triples of part 1 / part 2 faces
+  int condensed_non_manifold_ = 0;
+};
+
+// The tets of `tets` as a mesh of their own (same node numbering, cut flags kept; node
+// positions are not copied, only their count): for per-part queries (pieces, boundary).
+TetMesh tet_subset(const TetMesh& mesh, const std::vector<int>& tets);
+
+}  // namespace stc

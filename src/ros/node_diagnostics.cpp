@@ -1,0 +1,64 @@
+// /diagnostics from its own thread: LoopMonitor (worst step and rate over the last second,
+// stalls) plus the backend in use. It never takes the simulation lock, so it keeps publishing
+// while the simulation is busy, and a stalled loop shows up as an ERROR.
+#include "soft_tissue_cutting/ros/tissue_node.hpp"
+
+namespace stc {
+namespace ros_io {
+
+void TissueNode::diagnostics_thread() {
+  while (running_ && ros::ok()) {
+    diagnostics_.update();  // publishes once per its period (1 s)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+void TissueNode::remember_backend_locked() {
+  std::lock_guard<std::mutex> lock(info_mutex_);
+  backend_ = sim_->backend();
+  renderer_ = sim_->renderer();
+  backend_note_ = sim_->backend_note();
+}
+
+void TissueNode::remember_solver_failure(const std::string& why) {
+  std::lock_guard<std::mutex> lock(info_mutex_);
+  solver_failure_ = why;
+}
+
+void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const LoopHealth h = monitor_.health(LoopMonitor::Clock::now());
+  std::string backend, renderer, note, failure, solved_by, fallback;
+  {
+    std::lock_guard<std::mutex> lock(info_mutex_);
+    backend = backend_;
+    renderer = renderer_;
+    note = backend_note_;
+    failure = solver_failure_;
+    solved_by = solved_by_;
+    fallback = fallback_reason_;
+  }
+  const double period_ms = 1000.0 / params_.rate;
+  std::string summary = h.level == LoopHealth::kOk ? h.summary + " on " + backend : h.summary;
+  if (!h.stalled && !h.converged && !failure.empty()) summary += ": " + failure;
+  status.summary(h.level, summary);
+  status.add("rate target (Hz)", params_.rate);
+  status.add("rate achieved (Hz)", h.rate_hz);  // steps in the last second
+  status.add("rate kept", h.rate_hz >= 0.9 * params_.rate);
+  status.add("worst step last second (ms)", h.worst_step_ms);
+  status.add("worst step since start (ms)", h.worst_step_ms_ever);
+  status.add("period (ms)", period_ms);
+  status.add("steps over the period", h.slow_steps);
+  status.add("since last step (s)", h.since_last_step_s);
+  status.add("step in progress for (s)", h.busy_step_s);
+  status.add("stalled", h.stalled);
+  status.add("solver converged", h.converged);
+  status.add("backend", backend);
+  status.add("renderer", renderer);
+  status.add("backend note", note);
+  status.add("solved by", solved_by);  // cpu when a gl solve fell back
+  status.add("fallback reason", fallback);
+  status.add("steps", h.steps);
+}
+
+}  // namespace ros_io
+}  // namespace stc

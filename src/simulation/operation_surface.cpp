@@ -1,0 +1,70 @@
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
+
+#include <algorithm>
+
+namespace stc {
+namespace {
+
+std::array<int, 3> key(const Tri& t) {
+  std::array<int, 3> k = {t[0], t[1], t[2]};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+}  // namespace
+
+TetMesh tet_subset(const TetMesh& mesh, const std::vector<int>& tets) {
+  TetMesh sub;
+  sub.nodes.resize(mesh.nodes.size());  // counts only: boundary and pieces read topology
+  sub.tets.reserve(tets.size());
+  for (int t : tets) sub.tets.push_back(mesh.tets[static_cast<size_t>(t)]);
+  if (!mesh.cut_faces.empty()) {
+    sub.cut_faces.reserve(tets.size());
+    for (int t : tets) sub.cut_faces.push_back(mesh.cut_faces[static_cast<size_t>(t)]);
+  }
+  return sub;
+}
+
+BoundarySurface OperationSurface::part1_boundary(const TetMesh& mesh,
+                                                 const std::vector<int>& tets) {
+  BoundarySurface s = extract_boundary_surface(tet_subset(mesh, tets));
+  for (BoundaryTriangle& t : s.triangles) t.tet = tets[static_cast<size_t>(t.tet)];
+  return s;
+}
+
+void OperationSurface::init(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tet) {
+  const BoundarySurface full = extract_boundary_surface(mesh);
+  condensed_.clear();
+  std::vector<std::array<int, 3>> part1_on_boundary;
+  for (const BoundaryTriangle& t : full.triangles) {
+    if (operation_tet[static_cast<size_t>(t.tet)])
+      part1_on_boundary.push_back(key(t.nodes));
+    else
+      condensed_.push_back(t);
+  }
+  std::vector<int> part1;
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    if (operation_tet[static_cast<size_t>(t)]) part1.push_back(t);
+  const BoundarySurface own = part1_boundary(mesh, part1);
+  // Faces on part 1's own boundary that are not on the tissue's: shared with part 2.
+  std::sort(part1_on_boundary.begin(), part1_on_boundary.end());
+  shared_.clear();
+  for (const BoundaryTriangle& t : own.triangles)
+    if (!std::binary_search(part1_on_boundary.begin(), part1_on_boundary.end(), key(t.nodes)))
+      shared_.push_back(key(t.nodes));
+  std::sort(shared_.begin(), shared_.end());
+  condensed_non_manifold_ = std::max(0, full.non_manifold_faces - own.non_manifold_faces);
+}
+
+BoundarySurface OperationSurface::current(const TetMesh& mesh,
+                                          const std::vector<int>& operation_tets) const {
+  BoundarySurface s;
+  s.triangles = condensed_;
+  const BoundarySurface own = part1_boundary(mesh, operation_tets);
+  for (const BoundaryTriangle& t : own.triangles)
+    if (!std::binary_search(shared_.begin(), shared_.end(), key(t.nodes))) s.triangles.push_back(t);
+  s.non_manifold_faces = condensed_non_manifold_ + own.non_manifold_faces;
+  return s;
+}
+
+}  // namespace stc
