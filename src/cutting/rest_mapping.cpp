@@ -7,10 +7,11 @@ namespace stc {
 
 void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
                            const std::vector<std::uint8_t>& include) {
-  mesh_ = &mesh;
+  mesh_.nodes = mesh.nodes;
+  mesh_.tets = mesh.tets;
   std::vector<Vec3> x(mesh.nodes.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = mesh.nodes[i] + displacement[i];
-  locator_.build(mesh, x, include);
+  locator_.build(mesh_, x, include);
 }
 
 namespace {
@@ -24,7 +25,7 @@ Vec3 rest_point(const TetMesh& mesh, int tet, const std::array<double, 4>& w) {
 std::optional<Vec3> DeformedToRest::map(const Vec3& x) const {
   const auto hit = locator_.locate(x, 1e-9);
   if (!hit) return std::nullopt;
-  return rest_point(*mesh_, hit->tet, hit->barycentric);
+  return rest_point(mesh_, hit->tet, hit->barycentric);
 }
 
 std::optional<std::vector<Vec3>> DeformedToRest::map_edge(const Vec3& tip, const Vec3& heel,
@@ -37,7 +38,7 @@ std::optional<std::vector<Vec3>> DeformedToRest::map_edge(const Vec3& tip, const
     x[i] = tip + s[i] * (heel - tip);
     if (const auto hit = locator_.locate(x[i], 1e-9)) {
       tet[i] = hit->tet;
-      out[i] = rest_point(*mesh_, hit->tet, hit->barycentric);
+      out[i] = rest_point(mesh_, hit->tet, hit->barycentric);
     }
   }
   if (std::all_of(tet.begin(), tet.end(), [](int t) { return t < 0; })) return std::nullopt;
@@ -48,10 +49,10 @@ std::optional<std::vector<Vec3>> DeformedToRest::map_edge(const Vec3& tip, const
     for (size_t j = 0; j < n; ++j)
       if (tet[j] >= 0 && (nearest == n || std::abs(s[j] - s[i]) < std::abs(s[nearest] - s[i])))
         nearest = j;
-    const Tet& k = mesh_->tets[tet[nearest]];
+    const Tet& k = mesh_.tets[tet[nearest]];
     const auto w =
         barycentric(deformed[k[0]], deformed[k[1]], deformed[k[2]], deformed[k[3]], x[i]);
-    out[i] = rest_point(*mesh_, tet[nearest], w);
+    out[i] = rest_point(mesh_, tet[nearest], w);
   }
   return out;
 }

@@ -167,12 +167,23 @@ struct Simulation::Impl {
   // Inserts the sweep between two blade poses; returns true if the mesh changed. The blade
   // moves through the DEFORMED tissue: its edge is carried to rest coordinates through the
   // current deformation (rest_mapping.hpp) before the rest mesh is cut there.
-  bool cut(const BladePose& from, const BladePose& to, StepStats& s) {
+  // The current deformation of the operation part, for carrying blade points to rest.
+  std::shared_ptr<DeformedToRest> current_to_rest() const {
+    auto map = std::make_shared<DeformedToRest>();
+    map->build(model->mesh(), displacements(), model->partition().operation_tet);
+    return map;
+  }
+
+  // frozen: carry the blade through this deformation (a ~cut path's, PathCut::to_rest)
+  // instead of the current one.
+  bool cut(const BladePose& from, const BladePose& to, StepStats& s,
+           const DeformedToRest* frozen = nullptr) {
     const double length = scene.scalpel.blade_length;
     auto t0 = Clock::now();
     const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
-    DeformedToRest to_rest;
-    to_rest.build(model->mesh(), displacements(), model->partition().operation_tet);
+    std::shared_ptr<DeformedToRest> built;
+    if (!frozen) built = current_to_rest();
+    const DeformedToRest& to_rest = frozen ? *frozen : *built;
     constexpr int kSamples = 9;  // edge points carried; kept only where the map bends
     std::vector<double> params(kSamples);
     for (int i = 0; i < kSamples; ++i) params[i] = static_cast<double>(i) / (kSamples - 1);
@@ -413,15 +424,16 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     if (cut.done()) break;
     const BladePose& from = cut.poses[cut.next - 1];
     const BladePose& to = cut.poses[cut.next];
-    // Does the blade edge lie in the operation part here? (Tells "already cut" from "missed".)
+    if (!cut.to_rest) cut.to_rest = impl_->current_to_rest();
+    // Does the blade edge lie in the (deformed) operation part here? (Tells "already cut" from
+    // "missed".)
     if (!cut.crossed) {
       const BladeEdge e = blade_edge(from, length);
-      // In the DEFORMED tissue, where the blade is (the cut is carried to rest coordinates).
       for (const Vec3& x : {e.tip, Vec3(0.5 * (e.tip + e.heel)), e.heel})
-        cut.crossed = cut.crossed || impl_->surface_tree.contains(x);
+        cut.crossed = cut.crossed || cut.to_rest->map(x).has_value();
     }
     StepStats s;
-    changed |= impl_->cut(from, to, s);
+    changed |= impl_->cut(from, to, s, cut.to_rest.get());
     cut.tets_split += s.tets_split;
     cut.nodes_added += s.nodes_added;
     cut.reached_interface |= s.reached_interface;

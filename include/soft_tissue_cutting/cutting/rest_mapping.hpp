@@ -17,8 +17,13 @@ namespace stc {
 
 class DeformedToRest {
  public:
+  DeformedToRest() = default;
+  DeformedToRest(const DeformedToRest&) = delete;  // the locator points at mesh_
+  DeformedToRest& operator=(const DeformedToRest&) = delete;
   // displacement: per node; include: per tet, nonzero = the tets whose displacement is
-  // current (the operation part; empty = all).
+  // current (the operation part; empty = all). The rest nodes and tets are copied, so the map
+  // stays valid while the mesh is cut: a ~cut path is carried through the deformation it was
+  // requested in, however many steps run between its slices (simulation.hpp, PathCut).
   void build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
              const std::vector<std::uint8_t>& include = {});
   // The rest position of deformed point x, or nothing when x is in no included tet.
@@ -29,7 +34,7 @@ class DeformedToRest {
                                             const std::vector<double>& s) const;
 
  private:
-  const TetMesh* mesh_ = nullptr;
+  TetMesh mesh_;        // rest nodes and tets as built (no cut flags)
   TetLocator locator_;  // over deformed positions
 };
 
