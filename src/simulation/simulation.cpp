@@ -246,6 +246,12 @@ struct Simulation::Impl {
     for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
     for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
     hold_free_pieces();
+    // The held nodes leave the solver's factor (a piece held by a hinge would make it
+    // singular; cpu_cg_solver.cpp).
+    std::vector<int> held_nodes;
+    held_nodes.reserve(held.size());
+    for (const auto& [n, u] : held) held_nodes.push_back(n);
+    model->set_held_nodes(held_nodes);
     const Partition& p = model->partition();
     surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
                        p.operation_tet, displacements());

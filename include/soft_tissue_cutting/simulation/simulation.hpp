@@ -17,7 +17,7 @@
 namespace stc {
 
 class HybridModel;
-struct StepTimes;       // simulation/step_times.hpp
+struct StepTimes;      // simulation/step_times.hpp
 class DeformedToRest;  // cutting/rest_mapping.hpp
 
 struct SimulationOptions {
