@@ -176,8 +176,19 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6AndAnSpdSystem) {
   Simulation sim(scene);
   RandomStrokes random(20261123);
   const double r = scene.operation_region.sphere.radius;
-  const int cuts = run_random_strokes(sim, random, strokes, scene.operation_region.sphere.center,
-                                      0.8 * r, 0.8 * r, 0.0, 10);
+  // The liver hangs from its left lobe and sags; the blade cuts where the tissue IS, so the
+  // strokes go around the sagged operation region (its centre moved by the nearest node's
+  // displacement).
+  Vec3 centre = scene.operation_region.sphere.center;
+  {
+    const Eigen::VectorXd u = sim.full_displacement();
+    int nearest = 0;
+    for (int i = 1; i < sim.mesh().num_nodes(); ++i)
+      if ((sim.mesh().nodes[i] - centre).norm() < (sim.mesh().nodes[nearest] - centre).norm())
+        nearest = i;
+    centre += u.segment<3>(3 * nearest);
+  }
+  const int cuts = run_random_strokes(sim, random, strokes, centre, 0.8 * r, 0.8 * r, 0.0, 10);
   std::printf("liver random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n",
               cuts, strokes, sim.counts().tets_split, sim.counts().tets,
               sim.counts().free_pieces_held);
