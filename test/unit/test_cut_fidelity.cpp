@@ -136,9 +136,9 @@ Stroke variant(Stroke s, double tilt, double step, bool curved) {
   return s;
 }
 
-// The matrix of issue 9 item 1 on one mesh; each stroke on a fresh copy. Asserted here: the cut invariants
-// and floors well under what every configuration measures (a regression guard); the issue's
-// own targets are asserted where they are met (IssueTargets below) - README lists the rest.
+// The matrix of issue 9 item 1 on one mesh; each stroke on a fresh copy. Asserted here: the cut
+// invariants and floors well under what every configuration measures (a regression guard); the
+// issue's own targets are asserted where they are met (IssueTargets below) - README lists the rest.
 void measure_matrix(const std::string& mesh_name) {
   for (bool curved : {false, true})
     for (double tilt : {0.0, 45.0})
