@@ -47,8 +47,10 @@ std::map<int, Vec3> EdgeContact::update(const SurfaceBvh& bvh, const TetMesh& me
       if (bvh.is_operation(t)) near.push_back(bvh.surface().triangles[t]);
     tip_anchor_ = find_contact(mesh, u, near, edge.tip, reach);
     // Only a steep blade pushes with its tip; a blade lying on the skin presses with its
-    // edge (below), and its tip is just the end of that line.
-    if (tip_anchor_ && std::abs(e.dot(tip_anchor_->touch_normal)) <= options_.max_edge_slope)
+    // edge (below), and its tip is just the end of that line. Steep means min_tip_slope, not
+    // max_edge_slope: a vertical blade plunged into a sagged slope (37 deg from its normal)
+    // entered with its tip and registered no contact at all (its line passes no node).
+    if (tip_anchor_ && std::abs(e.dot(tip_anchor_->touch_normal)) <= options_.min_tip_slope)
       tip_anchor_.reset();
   }
   if (tip_anchor_) {

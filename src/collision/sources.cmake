@@ -4,6 +4,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/collision/blade.cpp
   src/collision/edge_contact.cpp
   src/collision/surface_bvh.cpp
+  src/collision/tet_locator.cpp
   src/collision/tip_contact.cpp
   src/collision/tissue_samples.cpp
 )

@@ -32,6 +32,11 @@ struct CutState {
   // that only appear when this sweep splits the tets around them, and that this sweep's own
   // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
+  // Per node (grown on demand): on the current stroke's cut surface - created on it by a
+  // split, taken onto it by the snap rule, or a copy made by opening it. Every triangle of the
+  // stroke treats these as "on", so a face whose nodes came onto the cut in different sweeps
+  // (a slow blade, a curved path) is still recognised as lying on the cut.
+  std::vector<std::uint8_t> on_stroke;
   std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
 };
 
@@ -39,6 +44,14 @@ struct CutState {
 // mesh.cut_faces to one entry per tet.
 CutState make_cut_state(TetMesh& mesh, std::vector<std::uint8_t> locked,
                         std::vector<std::uint8_t> cuttable);
+
+inline bool is_on_stroke(const CutState& state, int v) {
+  return static_cast<size_t>(v) < state.on_stroke.size() && state.on_stroke[v];
+}
+inline void set_on_stroke(CutState& state, int v) {
+  if (state.on_stroke.size() <= static_cast<size_t>(v)) state.on_stroke.resize(v + 1, 0);
+  state.on_stroke[v] = 1;
+}
 
 // The tets that use both a and b, ascending.
 std::vector<int> tets_with_edge(const CutState& state, int a, int b);

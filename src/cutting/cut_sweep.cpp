@@ -21,6 +21,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const CutOptions& options,
                         const std::vector<std::array<Vec3, 3>>& also_mark_in) {
   CutResult result;
+  // A new stroke: no node is on its cut surface yet.
+  if (also_mark_in.empty()) state.on_stroke.clear();
   std::set<FaceKey> new_faces;
   const long marked_before = count_marked_face_sides(mesh);
   std::vector<TriangleClassification> cut;
@@ -80,11 +82,55 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
 
 CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const BladeEdge& to,
                     const CutOptions& options) {
-  const double scale = std::max((from.heel - from.tip).norm(), (to.tip - from.tip).norm());
-  const bool continues = (from.tip - state.last_sweep_end[0]).norm() <= 1e-9 * scale &&
-                         (from.heel - state.last_sweep_end[1]).norm() <= 1e-9 * scale;
-  const std::vector<std::array<Vec3, 3>> sweep = {{from.tip, from.heel, to.heel},
-                                                  {from.tip, to.heel, to.tip}};
+  return cut_band(mesh, state, {from.tip, from.heel}, {to.tip, to.heel}, options);
+}
+
+CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from,
+                   const std::vector<Vec3>& to, const CutOptions& options) {
+  if (from.size() < 2 || from.size() != to.size()) return {};
+  const double scale =
+      std::max((from.back() - from.front()).norm(), (to.front() - from.front()).norm());
+  const bool continues = (from.front() - state.last_sweep_end[0]).norm() <= 1e-9 * scale &&
+                         (from.back() - state.last_sweep_end[1]).norm() <= 1e-9 * scale;
+  // The margin beyond the blade's fronts (CutOptions::front_margin).
+  double margin = options.front_margin;
+  if (margin < 0) {
+    Vec3 lo = from[0], hi = from[0];
+    for (const auto* line : {&from, &to})
+      for (const Vec3& x : *line) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+    double sum = 0;
+    long count = 0;
+    for (int t : state.grid.query(mesh, lo, hi)) {
+      if (!state.cuttable[t]) continue;
+      const Tet& k = mesh.tets[t];
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          sum += (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm(), ++count;
+    }
+    margin = count ? options.front_margin_fraction * sum / count : 0;
+  }
+  // Extended polylines: beyond tip and heel along the edge, ahead of the motion (and behind
+  // it where a stroke starts).
+  auto extend_ends = [margin](std::vector<Vec3> line) {
+    const Vec3 down = line.front() - line[1], up = line.back() - line[line.size() - 2];
+    if (down.norm() > 0) line.front() += margin * down.normalized();
+    if (up.norm() > 0) line.back() += margin * up.normalized();
+    return line;
+  };
+  std::vector<Vec3> a = extend_ends(from), b = extend_ends(to);
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Vec3 motion = b[i] - a[i];
+    if (!(motion.norm() > 0)) continue;
+    b[i] += margin * motion.normalized();
+    if (!continues) a[i] -= margin * motion.normalized();
+  }
+  // Each quad (a_i, a_i+1, b_i+1, b_i) as two triangles, tip side first as a single edge's
+  // sweep (A0, B0, B1), (A0, B1, A1).
+  std::vector<std::array<Vec3, 3>> sweep;
+  for (size_t i = 0; i + 1 < a.size(); ++i) {
+    sweep.push_back({a[i], a[i + 1], b[i + 1]});
+    sweep.push_back({a[i], b[i + 1], b[i]});
+  }
   const std::vector<std::array<Vec3, 3>> none;
   CutResult result =
       cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
@@ -98,7 +144,7 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
   if (state.last_sweep.size() > kMaxStrokeTriangles)
     state.last_sweep.erase(state.last_sweep.begin(),
                            state.last_sweep.end() - static_cast<long>(kMaxStrokeTriangles));
-  state.last_sweep_end = {to.tip, to.heel};
+  state.last_sweep_end = {to.front(), to.back()};
   return result;
 }
 

@@ -19,6 +19,12 @@ namespace stc {
 CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const BladeEdge& to,
                     const CutOptions& options = {});
 
+// The band swept between two polylines along the blade edge (tip first, same number of
+// points, >= 2), e.g. the edge at two poses carried to rest coordinates through the tissue's
+// deformation (rest_mapping.hpp); a straight edge is the two-point case.
+CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from,
+                   const std::vector<Vec3>& to, const CutOptions& options = {});
+
 // Any list of planar triangles, inserted as one cut (one separation at the end).
 // also_mark_in: earlier triangles of the same stroke; faces this cut creates that lie in one of
 // them are marked too (the split around a new triangle can expose a face of an old one).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <unordered_map>
 
 namespace stc {
 namespace {
@@ -41,11 +42,61 @@ std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh) {
 }
 
 std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored) {
+  // Pieces by shared FACES: a piece that hangs on the rest by a node or an edge only (a
+  // hinge: it can rotate about it) has a singular stiffness, so it counts as its own piece.
+  std::vector<int> parent(mesh.tets.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::unordered_map<std::uint64_t, int> first_tet;
+  first_tet.reserve(4 * mesh.tets.size());
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
+                                mesh.tets[t][kTetFaces[f][2]]};
+      std::sort(key.begin(), key.end());
+      const std::uint64_t h = (static_cast<std::uint64_t>(key[0]) << 42) ^
+                              (static_cast<std::uint64_t>(key[1]) << 21) ^
+                              static_cast<std::uint64_t>(key[2]);
+      auto [it, inserted] = first_tet.emplace(h, t);
+      if (inserted) continue;
+      const Tet& o = mesh.tets[it->second];
+      int shared = 0;  // guard against a hash collision: the faces must share all 3 nodes
+      for (int v : key) shared += std::find(o.begin(), o.end(), v) != o.end();
+      if (shared != 3) continue;
+      const int a = find_root(parent, t), b = find_root(parent, it->second);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<int> piece_of_root(mesh.tets.size(), -1);
+  std::vector<MeshPiece> pieces;
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    const int root = find_root(parent, t);
+    if (piece_of_root[root] < 0) {
+      piece_of_root[root] = static_cast<int>(pieces.size());
+      pieces.emplace_back();
+    }
+    pieces[piece_of_root[root]].tets.push_back(t);
+  }
   std::vector<MeshPiece> free;
-  for (MeshPiece& piece : mesh_pieces(mesh)) {
-    bool held = false;
-    for (int v : piece.nodes) held |= v < static_cast<int>(anchored.size()) && anchored[v];
-    if (!held) free.push_back(std::move(piece));
+  for (MeshPiece& piece : pieces) {
+    for (int t : piece.tets)
+      for (int v : mesh.tets[t]) piece.nodes.push_back(v);
+    std::sort(piece.nodes.begin(), piece.nodes.end());
+    piece.nodes.erase(std::unique(piece.nodes.begin(), piece.nodes.end()), piece.nodes.end());
+    // Held in place only by three anchored nodes that are not on one line (one or two
+    // would leave it free to rotate).
+    std::vector<Vec3> held;
+    for (int v : piece.nodes)
+      if (v < static_cast<int>(anchored.size()) && anchored[v]) held.push_back(mesh.nodes[v]);
+    bool rigid = false;
+    if (held.size() >= 3) {
+      size_t far = 1;
+      for (size_t i = 1; i < held.size(); ++i)
+        if ((held[i] - held[0]).norm() > (held[far] - held[0]).norm()) far = i;
+      const Vec3 axis = held[far] - held[0];
+      double off = 0;
+      for (const Vec3& x : held) off = std::max(off, axis.cross(x - held[0]).norm());
+      rigid = off > 1e-6 * axis.squaredNorm();  // a triangle of non-negligible area
+    }
+    if (!rigid) free.push_back(std::move(piece));
   }
   return free;
 }

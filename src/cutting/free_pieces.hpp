@@ -22,7 +22,9 @@ struct MeshPiece {
 // or edge implies a shared node), in order of their smallest tet.
 std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh);
 
-// The components with no anchored node (anchored: per node, e.g. fixed or interface nodes).
+// The pieces not held rigidly: components connected by shared FACES (a piece hanging on by a
+// node or an edge can rotate about it) with fewer than three non-collinear anchored nodes
+// (anchored: per node, e.g. fixed or interface nodes).
 std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored);
 
 }  // namespace stc

@@ -198,6 +198,7 @@ void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>&
       mesh.nodes.push_back(mesh.nodes[d.node]);
       state.locked.push_back(0);
       state.node_tets.emplace_back();
+      if (is_on_stroke(state, d.node)) set_on_stroke(state, copy);
       for (int t : d.pieces[p]) {
         std::replace(mesh.tets[t].begin(), mesh.tets[t].end(), d.node, copy);
         auto& star = state.node_tets[d.node];

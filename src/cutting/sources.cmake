@@ -6,6 +6,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/cutting/edge_bisection.cpp
   src/cutting/free_pieces.cpp
   src/cutting/invariants.cpp
+  src/cutting/rest_mapping.cpp
   src/cutting/separation.cpp
   src/cutting/tet_grid.cpp
   src/cutting/triangle_cut.cpp

@@ -1,6 +1,7 @@
 #include "cutting/triangle_cut.hpp"
 
 #include "cutting/edge_bisection.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -53,6 +54,50 @@ double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<S
   return smallest;
 }
 
+double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto angles = dihedral_angles_deg(a, b, c, d);
+  return *std::min_element(angles.begin(), angles.end());
+}
+
+// Moves node v to `target` if v is an interior, unlocked node of the operation part that no
+// marked face touches, and its star keeps positive volume above the size guard and a smallest
+// dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
+bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
+                   const CutOptions& options, CutResult& result) {
+  if (state.locked[v]) return false;
+  const std::vector<int>& star = state.node_tets[v];
+  for (int t : star) {
+    if (!state.cuttable[t]) return false;
+    for (int f = 0; f < 4; ++f) {
+      if (mesh.tets[t][f] == v) continue;        // the face opposite v does not touch it
+      if (mesh.is_cut_face(t, f)) return false;  // on an earlier cut
+      if (neighbour_across(mesh, state, t, f).first < 0) return false;  // on the boundary
+    }
+  }
+  double before = 180, after = 180;
+  auto position = [&](int w, const Vec3& here) -> const Vec3& {
+    return w == v ? here : mesh.nodes[w];
+  };
+  for (int t : star) {
+    const Tet& k = mesh.tets[t];
+    before = std::min(before, smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]],
+                                                mesh.nodes[k[2]], mesh.nodes[k[3]]));
+    const Vec3 &a = position(k[0], target), &b = position(k[1], target),
+               &c = position(k[2], target), &d = position(k[3], target);
+    if (!(signed_volume(a, b, c, d) > 2 * options.min_volume_fraction * state.origin_volume[t]))
+      return false;
+    after = std::min(after, smallest_dihedral(a, b, c, d));
+  }
+  if (after < std::min(before, options.relocate_min_dihedral_deg)) return false;
+  mesh.nodes[v] = target;
+  for (int t : star) {
+    state.grid.insert(mesh, t);  // its box may have grown
+    result.changed_tets.push_back(t);
+  }
+  result.moved_nodes.push_back(v);
+  return true;
+}
+
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi) {
   std::vector<int> tets;
@@ -81,6 +126,7 @@ bool TriangleClassification::contains(const Vec3& p, double tol) const {
 }
 
 int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int v) {
+  if (is_on_stroke(state, v)) return 0;  // on the stroke's cut surface (cut_state.hpp)
   auto it = side_.find(v);
   if (it != side_.end()) return it->second;
   const double d = distance(mesh, v);
@@ -149,8 +195,20 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
           continue;
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
+        // Near an end: move that end onto the cut if it may move (relocate_node).
+        if (s < options.relocate || s > 1 - options.relocate) {
+          const int end = s < 0.5 ? u : v;
+          if (relocate_node(mesh, state, end, mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
+                            options, result)) {
+            tri.set_on(end);
+            set_on_stroke(state, end);
+            resnap = true;
+            continue;
+          }
+        }
         if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
           tri.set_on(s < 0.5 ? u : v);
+          set_on_stroke(state, s < 0.5 ? u : v);
           resnap = true;
           continue;
         }
@@ -181,6 +239,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         if (1 - s.t < best) best = 1 - s.t, nearest = s.b;
       }
       tri.set_on(nearest);
+      set_on_stroke(state, nearest);
       snapped = true;
     }
     if (!snapped) break;
@@ -192,6 +251,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
     tri.set_on(m);
+    set_on_stroke(state, m);
     NewNode node;
     node.index = m;
     node.kind = NewNode::Kind::kEdgeSplit;
@@ -216,14 +276,24 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       if (tri.side(mesh, state, p) != 0 || tri.side(mesh, state, q) != 0 ||
           tri.side(mesh, state, r) != 0)
         continue;
-      const int here = tri.side(mesh, state, tet[f]);
-      if (here == 0) continue;
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
-      if (tri.side(mesh, state, mesh.tets[other][other_face]) != -here) continue;
-      if (!tri.contains((mesh.nodes[p] + mesh.nodes[q] + mesh.nodes[r]) / 3.0,
-                        options.inside_tolerance))
+      // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
+      // vertex that is itself on the cut says nothing.
+      const int here = tri.side(mesh, state, tet[f]);
+      const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
+      if (here != 0 && there != 0 && here == there) continue;
+      const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];
+      const Vec3 centroid = (xp + xq + xr) / 3.0;
+      if (!tri.contains(centroid, options.inside_tolerance)) continue;
+      // Nodes that came onto the cut in other sweeps of the stroke lie on it up to the snap
+      // rule: the face must lie along this triangle, near its plane and facing its way.
+      const Vec3 n = (xq - xp).cross(xr - xp);
+      const double longest = std::max({(xq - xp).norm(), (xr - xq).norm(), (xp - xr).norm()});
+      if (std::abs(tri.normal().dot(centroid - mesh.nodes[p]) + tri.distance(mesh, p)) >
+          0.25 * longest)
         continue;
+      if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) continue;
       if (!state.cuttable[other]) {  // the blade stops at the condensed part
         result.reached_interface = true;
         continue;

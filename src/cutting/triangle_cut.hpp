@@ -29,6 +29,7 @@ class TriangleClassification {
   double distance(const TetMesh& mesh, int v) const { return normal_.dot(mesh.nodes[v] - a_); }
   int side(const TetMesh& mesh, const CutState& state, int v);
   void set_on(int v) { side_[v] = 0; }
+  const Vec3& normal() const { return normal_; }
   void bounds(Vec3& lo, Vec3& hi) const;
 
  private:

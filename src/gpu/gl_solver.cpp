@@ -43,7 +43,11 @@ class GlSolver final : public LinearSolver {
   std::string renderer() const override { return ctx_->renderer(); }
   std::string preconditioner() const override { return "jacobi"; }
 
-  void set_matrix(const SparseMatrix& a) override {
+  void set_matrix(const SparseMatrix& a) override { set_matrix(a, {}); }
+
+  // Jacobi-CG needs no factor; `held` goes to the CPU fallback's Cholesky preconditioner.
+  void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held) override {
+    held_ = held;
     ctx_->make_current();
     a_ = a;
     cpu_has_matrix_ = false;
@@ -195,7 +199,7 @@ class GlSolver final : public LinearSolver {
                      const CgSettings& settings, const CgResult& gl, const std::string& why) {
     if (!cpu_) cpu_ = make_cpu_solver();
     if (!cpu_has_matrix_) {
-      cpu_->set_matrix(a_);
+      cpu_->set_matrix(a_, held_);
       cpu_has_matrix_ = true;
     }
     CgSettings rest = settings;
@@ -214,6 +218,7 @@ class GlSolver final : public LinearSolver {
   std::string unusable_;  // why the current matrix cannot go to the GPU (empty: it can)
   std::unique_ptr<LinearSolver> cpu_;  // the fallback, made and factored only when needed
   bool cpu_has_matrix_ = false;
+  std::vector<std::uint8_t> held_;  // per DOF, for the CPU fallback (set_matrix)
 };
 
 }  // namespace

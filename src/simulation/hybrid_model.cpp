@@ -2,6 +2,7 @@
 
 #include "soft_tissue_cutting/assembly/loads.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -64,6 +65,7 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
       gravity_(scene.gravity),
       point_loads_(point_loads(scene)),
       fixed_(fixed_node_mask(scene)),
+      held_(scene.mesh.nodes.size(), 0),
       solver_(std::move(solver)) {
   if (!solver_) throw std::invalid_argument("HybridModel: no linear solver");
   settings_.tolerance = scene.solver.tolerance;
@@ -160,7 +162,7 @@ void HybridModel::rebuild_hybrid_system() {
   b_ = gather(f, dofs_);
   for (int k = 0; k < idofs.rows(); ++k)
     b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
-  solver_->set_matrix(a_);
+  solver_->set_matrix(a_, held_dofs());
   system_changed_ = true;
 }
 
@@ -261,6 +263,7 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   u_.conservativeResize(3 * n);
   point_loads_.conservativeResize(3 * n);
   fixed_.resize(static_cast<size_t>(n), 0);
+  held_.resize(static_cast<size_t>(n), 0);
   for (int k = 0; k < static_cast<int>(new_nodes.size()); ++k) {
     const int node = old_nodes + k;
     const NewNode& nn = new_nodes[static_cast<size_t>(k)];
@@ -275,6 +278,7 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     } else {
       u_.segment<3>(3 * node) = u_.segment<3>(3 * nn.a);
       fixed_[static_cast<size_t>(node)] = fixed_[static_cast<size_t>(nn.a)];
+      held_[static_cast<size_t>(node)] = held_[static_cast<size_t>(nn.a)];
     }
     point_loads_.segment<3>(3 * node).setZero();
   }
@@ -302,10 +306,34 @@ void HybridModel::set_young_modulus(double young_modulus) {
   rebuild_hybrid_system();
 }
 
+std::vector<std::uint8_t> HybridModel::held_dofs() const {
+  std::vector<std::uint8_t> rows;
+  if (std::find(held_.begin(), held_.end(), 1) == held_.end()) return rows;  // none held
+  rows.assign(static_cast<size_t>(dofs_.rows()), 0);
+  for (int r = 0; r < dofs_.rows(); ++r) {
+    const size_t node = static_cast<size_t>(dofs_.global_of[static_cast<size_t>(r)] / 3);
+    rows[static_cast<size_t>(r)] = node < held_.size() && held_[node];
+  }
+  return rows;
+}
+
+void HybridModel::set_held_nodes(const std::vector<int>& nodes) {
+  std::vector<std::uint8_t> held(static_cast<size_t>(mesh_.num_nodes()), 0);
+  for (int n : nodes) {
+    if (n < 0 || n >= mesh_.num_nodes())
+      throw std::invalid_argument("HybridModel::set_held_nodes: node out of range");
+    held[static_cast<size_t>(n)] = 1;
+  }
+  if (held == held_) return;
+  held_ = std::move(held);
+  solver_->set_matrix(a_, held_dofs());
+  system_changed_ = true;
+}
+
 void HybridModel::set_solver(std::unique_ptr<LinearSolver> solver) {
   if (!solver) throw std::invalid_argument("HybridModel: no linear solver");
   solver_ = std::move(solver);
-  solver_->set_matrix(a_);
+  solver_->set_matrix(a_, held_dofs());
   system_changed_ = true;
 }
 

@@ -15,7 +15,7 @@ std::array<int, 3> key(const Tri& t) {
 
 TetMesh tet_subset(const TetMesh& mesh, const std::vector<int>& tets) {
   TetMesh sub;
-  sub.nodes.resize(mesh.nodes.size());  // counts only: boundary and pieces read topology
+  sub.nodes = mesh.nodes;  // free_pieces reads anchored nodes' positions
   sub.tets.reserve(tets.size());
   for (int t : tets) sub.tets.push_back(mesh.tets[static_cast<size_t>(t)]);
   if (!mesh.cut_faces.empty()) {

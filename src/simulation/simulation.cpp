@@ -8,6 +8,7 @@
 #include "soft_tissue_cutting/collision/edge_contact.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/cutting/blade_path.hpp"
+#include "soft_tissue_cutting/cutting/rest_mapping.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
@@ -25,21 +26,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-// A point lies inside the (rest) tissue: in some tet near it.
-bool inside_rest_tissue(const TetMesh& mesh, const CutState& state, const Vec3& tip) {
-  for (int t : state.grid.query(mesh, tip, tip)) {
-    const Tet& k = mesh.tets[t];
-    const Vec3 &a = mesh.nodes[k[0]], &b = mesh.nodes[k[1]], &c = mesh.nodes[k[2]],
-               &d = mesh.nodes[k[3]];
-    const double v = signed_volume(a, b, c, d);
-    const double eps = -1e-12 * std::abs(v);
-    if (signed_volume(tip, b, c, d) >= eps && signed_volume(a, tip, c, d) >= eps &&
-        signed_volume(a, b, tip, d) >= eps && signed_volume(a, b, c, tip) >= eps)
-      return true;
-  }
-  return false;
 }
 
 // Median edge length of the operation part's tets (0 if it has none).
@@ -87,6 +73,10 @@ struct Simulation::Impl {
   EdgeContact contact;  // the nodes the blade holds while pressing (tip and edge)
   std::optional<BladePose> last_pose;
   std::vector<BladePose> stroke;  // poses of the current cutting stroke
+  // The last cut's end edge carried to rest coordinates, and the pose it was carried for: the
+  // next sweep of the same stroke starts from exactly this polyline (no gap, no overlap).
+  std::optional<BladePose> last_cut_pose;
+  std::vector<Vec3> last_rest_edge;
 
   bool cutting_enabled = true;
   std::uint64_t steps = 0, surface_version = 0;
@@ -153,6 +143,8 @@ struct Simulation::Impl {
     contact.release();
     last_pose.reset();
     stroke.clear();
+    last_cut_pose.reset();
+    last_rest_edge.clear();
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
@@ -196,21 +188,94 @@ struct Simulation::Impl {
     return r.converged;
   }
 
-  // Inserts the sweep between two blade poses; returns true if the mesh changed.
-  bool cut(const BladePose& from, const BladePose& to, StepStats& s) {
+  // Inserts the sweep between two blade poses; returns true if the mesh changed. The blade
+  // moves through the DEFORMED tissue: its edge is carried to rest coordinates through the
+  // current deformation (rest_mapping.hpp) before the rest mesh is cut there.
+  // The current deformation of the operation part, for carrying blade points to rest.
+  std::shared_ptr<DeformedToRest> current_to_rest() const {
+    auto map = std::make_shared<DeformedToRest>();
+    map->build(model->mesh(), displacements(), model->partition().operation_tet);
+    return map;
+  }
+
+  // frozen: carry the blade through this deformation (a ~cut path's, PathCut::to_rest)
+  // instead of the current one.
+  bool cut(const BladePose& from, const BladePose& to, StepStats& s,
+           const DeformedToRest* frozen = nullptr) {
     const double length = scene.scalpel.blade_length;
     auto t0 = Clock::now();
-    const CutResult r = cut_sweep(model->mesh_for_cutting(), cut_state, blade_edge(from, length),
-                                  blade_edge(to, length));
+    const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
+    std::shared_ptr<DeformedToRest> built;
+    if (!frozen) built = current_to_rest();
+    const DeformedToRest& to_rest = frozen ? *frozen : *built;
+    constexpr int kSamples = 9;  // edge points carried; kept only where the map bends
+    std::vector<double> params(kSamples);
+    for (int i = 0; i < kSamples; ++i) params[i] = static_cast<double>(i) / (kSamples - 1);
+    const bool continues = last_cut_pose && last_cut_pose->position == from.position &&
+                           last_cut_pose->orientation.coeffs() == from.orientation.coeffs() &&
+                           last_rest_edge.size() == static_cast<size_t>(kSamples);
+    std::optional<std::vector<Vec3>> rest_from =
+        continues ? std::optional<std::vector<Vec3>>(last_rest_edge)
+                  : to_rest.map_edge(a.tip, a.heel, params);
+    std::optional<std::vector<Vec3>> rest_to = to_rest.map_edge(b.tip, b.heel, params);
+    // An edge wholly outside the tissue moves with the other edge's deformation.
+    auto shifted = [&](const std::vector<Vec3>& rest, const BladeEdge& e, const BladeEdge& other) {
+      std::vector<Vec3> out(rest.size());
+      for (size_t i = 0; i < rest.size(); ++i)
+        out[i] = rest[i] + (e.tip - other.tip) +
+                 params[i] * ((e.heel - e.tip) - (other.heel - other.tip));
+      return out;
+    };
+    if (!rest_from && rest_to) rest_from = shifted(*rest_to, a, b);
+    if (rest_from && !rest_to) rest_to = shifted(*rest_from, b, a);
+    if (!rest_from && !rest_to) {
+      // Both ends outside (a sweep across the tissue, e.g. the ~cut service): carry both by
+      // the deformation where the edge is in the tissue on the way between them.
+      constexpr int kBetween = 16;
+      for (int k = 1; k < kBetween && !rest_to; ++k) {
+        const double f = static_cast<double>(k) / kBetween;
+        BladeEdge mid;
+        mid.tip = (1 - f) * a.tip + f * b.tip;
+        mid.heel = (1 - f) * a.heel + f * b.heel;
+        if (const auto rest_mid = to_rest.map_edge(mid.tip, mid.heel, params)) {
+          rest_from = shifted(*rest_mid, a, mid);
+          rest_to = shifted(*rest_mid, b, mid);
+        }
+      }
+    }
+    last_cut_pose = to;
+    last_rest_edge = rest_to ? *rest_to : std::vector<Vec3>{};
+    if (!rest_from || !rest_to) {  // the edge never meets the operation part
+      s.cutting_ms += ms_since(t0);
+      return false;
+    }
+    const std::vector<int> keep = simplify_polylines(*rest_from, *rest_to, 0.25e-3);
+    std::vector<Vec3> band_from, band_to;
+    for (int k : keep) band_from.push_back((*rest_from)[k]), band_to.push_back((*rest_to)[k]);
+    const CutResult r = cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to);
     s.cutting_ms += ms_since(t0);
     s.reached_interface |= r.reached_interface;
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
     t0 = Clock::now();
     model->update_operation_part(r.changed_tets, r.new_nodes);
-    anchored.resize(static_cast<size_t>(model->mesh().num_nodes()), 0);
-    for (const NewNode& n : r.new_nodes)  // a copy of an anchored (fixed) node stays anchored
-      if (n.kind == NewNode::Kind::kDuplicate) anchored[n.index] = anchored[n.a];
+    // A copy of a held node stays held (both halves of a cut held piece stay put).
+    for (const NewNode& n : r.new_nodes)
+      if (n.kind == NewNode::Kind::kDuplicate)
+        if (const auto it = held.find(n.a); it != held.end()) held[n.index] = it->second;
+    // Anchored = what really holds a node: fixed, on the interface, or held. Recomputed, not
+    // inherited by copies: a copy of an interface node is not attached to the condensed part,
+    // and a node marked anchored without an imposed displacement would count towards the
+    // three anchors of a piece that in fact floats (a singular system; CG stalls).
+    anchored = model->fixed_nodes();
+    for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
+    for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
     hold_free_pieces();
+    // The held nodes leave the solver's factor (a piece held by a hinge would make it
+    // singular; cpu_cg_solver.cpp).
+    std::vector<int> held_nodes;
+    held_nodes.reserve(held.size());
+    for (const auto& [n, u] : held) held_nodes.push_back(n);
+    model->set_held_nodes(held_nodes);
     const Partition& p = model->partition();
     surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
                        p.operation_tet, displacements());
@@ -414,12 +479,13 @@ struct Simulation::Impl {
     return n;
   }
 
-  bool edge_inside_tissue(const BladeEdge& edge) const {
-    return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length, [&](const Vec3& p) {
-      // `follow`: the condensed part is tissue too (the blade may wait there for a move).
-      return follower ? follower->inside_tissue(*model, cut_state, p)
-                      : inside_rest_tissue(model->mesh(), cut_state, p);
-    });
+  // Is the edge in the DEFORMED tissue, where the blade is (issue 9)? The whole closed surface
+  // answers, so with a `follow` region the condensed part is tissue too (the blade may wait
+  // there for a move).
+  bool edge_inside_tissue(const BladeEdge& edge) {
+    surface_tree.refit(model->mesh(), displacements());
+    return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length,
+                          [&](const Vec3& p) { return surface_tree.contains(p); });
   }
 
   StepStats step(const std::optional<BladePose>& blade) {
@@ -556,15 +622,17 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     if (cut.done()) break;
     const BladePose& from = cut.poses[cut.next - 1];
     const BladePose& to = cut.poses[cut.next];
-    // Does the blade edge lie in the operation part here? (Tells "already cut" from "missed".)
+    if (!cut.to_rest) cut.to_rest = impl_->current_to_rest();
+    // Does the blade edge lie in the (deformed) operation part here? (Tells "already cut" from
+    // "missed".)
     if (!cut.crossed) {
       const BladeEdge e = blade_edge(from, length);
       for (const Vec3& x : {e.tip, Vec3(0.5 * (e.tip + e.heel)), e.heel})
-        cut.crossed = cut.crossed || inside_rest_tissue(mesh(), impl_->cut_state, x);
+        cut.crossed = cut.crossed || cut.to_rest->map(x).has_value();
     }
     StepStats s;
     if (impl_->follower) impl_->move_region_for_path_sweep(from, to);
-    changed |= impl_->cut(from, to, s);
+    changed |= impl_->cut(from, to, s, cut.to_rest.get());
     cut.tets_split += s.tets_split;
     cut.nodes_added += s.nodes_added;
     cut.reached_interface |= s.reached_interface;

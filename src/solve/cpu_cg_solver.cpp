@@ -22,10 +22,20 @@
 //             held_dof_solve.cpp), counted as one iteration; CG runs only if its true residual
 //             misses the tolerance.
 // A held free piece (simulation.cpp) makes A singular: its rigid modes are unanchored, though
-// every DOF of it is constrained. The piece is its own connected block of A, so A + d*diag(A)
-// with tiny d keeps (A^-1)_ff of the anchored rest to ~d*cond(A) and only perturbs the piece,
-// which P zeroes: that is the second attempt. An indefinite A (no SPD factor even shifted)
-// falls back to Jacobi for that matrix; preconditioner() reports it.
+// every DOF of it is constrained. When the caller names the held DOFs (set_matrix(a, held)),
+// the factor is of A_kk, A without them (k = the kept DOFs): SPD, no shift, and since every
+// held DOF is constrained in every solve, (A_kk^-1)_ff is again the inverse of the Schur
+// complement on the free DOFs (block inverse within k), so the iteration count stays
+// #constrained-DOFs-of-k + 1. A held DOF that a solve leaves free gets Jacobi (the preconditioner
+// stays SPD). Without the held DOFs named, A + d*diag(A) with tiny d is the second attempt: it
+// keeps (A^-1)_ff of the anchored rest to ~d*cond(A) when the piece is its own connected block
+// of A, but a piece held by a hinge (a node or an edge shared with the rest) couples its
+// near-null modes, amplified by 1/d, into the free DOFs: with slivers (cond ~1e8) the
+// preconditioner degrades to Jacobi-like and CG stalls short of 1e-10. An indefinite A (no SPD
+// factor even shifted) falls back to Jacobi for that matrix; preconditioner() reports it.
+//
+// The direct step (held_dof_solve) needs the factor of A itself: with held free-piece DOFs
+// left out of the factor (A_kk), a step is solved by the preconditioned CG alone.
 #include "soft_tissue_cutting/solve/held_dof_solve.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
@@ -35,6 +45,8 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace stc {
 namespace {
@@ -57,9 +69,24 @@ class CpuCgSolver final : public LinearSolver {
   std::string preconditioner() const override { return active_; }
   double setup_ms() const override { return setup_ms_; }
 
-  void set_matrix(const SparseMatrix& a) override {
+  void set_matrix(const SparseMatrix& a) override { set_matrix(a, {}); }
+
+  void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held) override {
     const auto t0 = std::chrono::steady_clock::now();
     a_ = a;
+    kept_.clear();
+    held_mask_ = Vector::Zero(a_.rows());
+    if (!held.empty()) {
+      if (static_cast<Eigen::Index>(held.size()) != a_.rows())
+        throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
+                                    " entries for " + std::to_string(a_.rows()) + " DOFs");
+      for (Eigen::Index i = 0; i < a_.rows(); ++i)
+        if (held[static_cast<size_t>(i)])
+          held_mask_[i] = 1;
+        else
+          kept_.push_back(static_cast<int>(i));
+      if (static_cast<Eigen::Index>(kept_.size()) == a_.rows()) kept_.clear();  // none held
+    }
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -99,14 +126,21 @@ class CpuCgSolver final : public LinearSolver {
     }
     const Vector m = inv_diag_.cwiseProduct(free_mask);  // projected Jacobi preconditioner
     const auto precondition = [&](const Vector& r) -> Vector {
-      if (chol_) return chol_->solve(r).cwiseProduct(free_mask);
-      return m.cwiseProduct(r);
+      if (!chol_) return m.cwiseProduct(r);
+      if (kept_.empty()) return chol_->solve(r).cwiseProduct(free_mask);
+      // Factor of A_kk on the kept DOFs; Jacobi on a held DOF this solve leaves free.
+      Vector rk(static_cast<Eigen::Index>(kept_.size()));
+      for (size_t i = 0; i < kept_.size(); ++i) rk[static_cast<Eigen::Index>(i)] = r[kept_[i]];
+      const Vector zk = chol_->solve(rk);
+      Vector z = m.cwiseProduct(r).cwiseProduct(held_mask_);
+      for (size_t i = 0; i < kept_.size(); ++i) z[kept_[i]] = zk[static_cast<Eigen::Index>(i)];
+      return z.cwiseProduct(free_mask);
     };
 
     // With the factor of A: the direct solve through the capacitance on the held DOFs
     // (docs/DESIGN.md eqs. (24)-(25)), counted as one iteration, unless the warm start
     // already solves the system. Its true residual decides; CG goes on from it otherwise.
-    if (chol_ && settings.max_iterations > 0) {
+    if (chol_ && kept_.empty() && settings.max_iterations > 0) {  // factor of A itself
       const double warm = (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
       if (warm > settings.tolerance) {
         Vector direct = x;
@@ -175,20 +209,43 @@ class CpuCgSolver final : public LinearSolver {
   }
 
  private:
-  // A itself, else A + kShift diag(A) (held free piece), else Jacobi stays active.
+  // The matrix to factor: A, or A_kk without the held DOFs.
+  SparseMatrix factored_block() const {
+    if (kept_.empty()) return a_;
+    std::vector<int> index(static_cast<size_t>(a_.rows()), -1);
+    for (size_t i = 0; i < kept_.size(); ++i)
+      index[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<size_t>(a_.nonZeros()));
+    for (int c = 0; c < a_.outerSize(); ++c)
+      for (SparseMatrix::InnerIterator it(a_, c); it; ++it) {
+        const int i = index[static_cast<size_t>(it.row())],
+                  j = index[static_cast<size_t>(it.col())];
+        if (i >= 0 && j >= 0) t.emplace_back(i, j, it.value());
+      }
+    const auto n = static_cast<Eigen::Index>(kept_.size());
+    SparseMatrix out(n, n);
+    out.setFromTriplets(t.begin(), t.end());
+    return out;
+  }
+
+  // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
+  // active.
   void factor() {
     if (a_.rows() == 0) return;
+    const SparseMatrix block = factored_block();
+    if (block.rows() == 0) return;
     try {
-      chol_ =
-          std::make_unique<SparseCholesky>(a_, CholeskyMethod::kSupernodal, CholeskyOrdering::kAmd);
+      chol_ = std::make_unique<SparseCholesky>(block, CholeskyMethod::kSupernodal,
+                                               CholeskyOrdering::kAmd);
       active_ = "cholesky";
       return;
     } catch (const std::runtime_error&) {
     }
-    SparseMatrix shifted = a_;
-    const double dmax = a_.diagonal().cwiseAbs().maxCoeff();
+    SparseMatrix shifted = block;
+    const double dmax = block.diagonal().cwiseAbs().maxCoeff();
     for (Eigen::Index i = 0; i < shifted.rows(); ++i) {
-      const double d = a_.coeff(i, i);
+      const double d = block.coeff(i, i);
       shifted.coeffRef(i, i) += kShift * (d > 0 ? d : dmax);
     }
     try {
@@ -204,7 +261,9 @@ class CpuCgSolver final : public LinearSolver {
   SparseMatrix a_;
   Vector inv_diag_;
   std::unique_ptr<SparseCholesky> chol_;
-  HeldDofSolve held_;  // y = A^-1 b and A^-1 e_c of held DOFs, for the current matrix
+  HeldDofSolve held_;      // y = A^-1 b and A^-1 e_c of held DOFs, for the current matrix
+  std::vector<int> kept_;  // DOFs in the factor when some are held (empty: all)
+  Vector held_mask_;       // per DOF: 1 = held (named in set_matrix)
   std::string active_ = "jacobi";
   double setup_ms_ = 0;
 };

@@ -47,6 +47,10 @@ struct EdgeContactOptions {
   double min_plane_alignment = 0.5;  // blade plane within 60 deg of the skin normal
   double max_entry_depth = 0.15;     // x longest edge: deepest a node the end slides under may be
   double tip_reach = 0.5;            // x blade_length: how deep the tip may be to anchor
+  // |edge . n| above this (about 30 deg from the skin): the tip pushes (tip anchor). Below
+  // max_edge_slope too, so a blade between 30 and 60 deg presses with both: a plunge along
+  // its own edge passes no node with its line, and only the tip can register it.
+  double min_tip_slope = 0.5;
 };
 
 struct EdgeHeldNode {

@@ -28,6 +28,14 @@ struct CutOptions {
   // lopsided keeps the cut as close to the blade as this allows: the cut surface lies at
   // most snap * (edge length) off the blade.
   double snap_tolerance = 0.1;
+  // Shape, not only size: an edge the cut crosses at t < relocate (or > 1 - relocate) has its
+  // nearer end MOVED onto the cut (rest position) instead of being split into a thin sliver,
+  // when that end is an interior node of the operation part (not on the boundary, not on an
+  // earlier cut, not locked) and no tet of its star gets worse than
+  // min(relocate_min_dihedral_deg, its current smallest dihedral angle). Moving an interior
+  // node keeps the total volume exactly (its star still tiles the same cavity).
+  double relocate = 0.3;
+  double relocate_min_dihedral_deg = 10.0;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
   // docs/SCENE.md "Cut invariants": "small fraction" is this number. With snap 0.1 a tet can be cut
@@ -36,6 +44,14 @@ struct CutOptions {
   // Barycentric slack of "inside the sweep triangle" (crossing points and face centroids),
   // so a cut along a triangle's border and consecutive sweeps leave no gap.
   double inside_tolerance = 1e-9;
+  // The swept band is extended by this much beyond the blade's tip and heel and ahead of its
+  // motion (m; negative = front_margin_fraction of the mean edge length of the tets the band
+  // meets). A crack front inside a tet cannot open (its nodes' stars stay connected), so
+  // without a margin every front - the tip's path, the blade's leading edge - stays closed up
+  // to a whole element short of where the blade is; with it, the cut opens to within about
+  // the margin of the blade either way.
+  double front_margin = -1;
+  double front_margin_fraction = 0.25;
 };
 
 struct CutResult {
@@ -43,6 +59,9 @@ struct CutResult {
   // their index for the first child; the other children are appended.
   std::vector<int> changed_tets;
   std::vector<NewNode> new_nodes;
+  // Existing nodes whose rest position a cut moved onto the cut surface (their tets are in
+  // changed_tets: their element matrices change).
+  std::vector<int> moved_nodes;
   int tets_split = 0;              // parent tets bisected (a tet split twice counts twice)
   int nodes_added = 0;             // edge nodes + duplicates
   int cut_faces_added = 0;         // net new cut faces (each face once; a halved one counts 1 more)

@@ -92,6 +92,11 @@ class HybridModel {
   // (K2_NN^-1 K2_NI and K2_IN K2_NN^-1 f_N are ratios), no refactorization.
   void set_young_modulus(double young_modulus);
 
+  // Nodes held in place in every solve until changed (free pieces, simulation.cpp): the solver
+  // builds its preconditioner without their DOFs (LinearSolver::set_matrix). A copy made of a
+  // held node by a cut is held too. Refactors only when the set changes.
+  void set_held_nodes(const std::vector<int>& nodes);
+
   void set_solver(std::unique_ptr<LinearSolver> solver);
   const LinearSolver& solver() const { return *solver_; }
   // New settings: the next solve runs even if nothing else changed (a tighter tolerance).
@@ -122,12 +127,14 @@ class HybridModel {
  private:
   void condense_and_assemble(std::chrono::steady_clock::time_point start);
   void rebuild_hybrid_system();
+  std::vector<std::uint8_t> held_dofs() const;  // per hybrid row, from held_
 
   TetMesh mesh_;
   Vec3 gravity_ = Vec3::Zero();
   Vector point_loads_;               // 3n, new nodes unloaded
   Vector condensed_gravity_;         // gravity of part-2 tets (3n at construction)
   std::vector<std::uint8_t> fixed_;  // per node
+  std::vector<std::uint8_t> held_;   // per node (set_held_nodes)
   ElementStiffnessCache elements_;
   Partition partition_;
   CondensedPart condensed_;

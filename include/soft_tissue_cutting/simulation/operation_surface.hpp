@@ -29,8 +29,9 @@ class OperationSurface {
   int condensed_non_manifold_ = 0;
 };
 
-// The tets of `tets` as a mesh of their own (same node numbering, cut flags kept; node
-// positions are not copied, only their count): for per-part queries (pieces, boundary).
+// The tets of `tets` as a mesh of their own (same node numbering and rest positions, cut flags
+// kept): for per-part queries (pieces, boundary). Positions are copied because the free-piece
+// rule asks whether a piece's anchored nodes span a triangle (cutting/free_pieces.hpp).
 TetMesh tet_subset(const TetMesh& mesh, const std::vector<int>& tets);
 
 }  // namespace stc

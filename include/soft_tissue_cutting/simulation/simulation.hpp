@@ -22,6 +22,7 @@ namespace stc {
 class HybridModel;
 struct RegionMoveStats;  // simulation/region_move_stats.hpp
 struct StepTimes;        // simulation/step_times.hpp
+class DeformedToRest;    // cutting/rest_mapping.hpp
 
 // The core's log sink: where Simulation sends its messages (a free piece held, ...). The core
 // never writes to stderr itself: `tissue solve` prints them, tissue_node routes them to
@@ -86,6 +87,10 @@ struct PathCut {
   bool changed = false;            // some sweep changed the mesh
   bool crossed = false;            // some pose of the blade edge lay in the operation part
   bool reached_interface = false;  // cut faces dropped at the interface of the condensed part
+  // The deformation when the path was begun: every sweep of the path is carried to rest
+  // coordinates through it, so the cut does not depend on how many steps (each a solve) run
+  // between slices - the path is where the tissue was when the cut was asked for.
+  std::shared_ptr<const DeformedToRest> to_rest;
   bool done() const { return !refusal.empty() || next >= poses.size(); }
 };
 

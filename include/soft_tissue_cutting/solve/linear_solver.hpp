@@ -54,6 +54,14 @@ class LinearSolver {
   virtual double setup_ms() const { return 0; }
   // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.
   virtual void set_matrix(const SparseMatrix& a) = 0;
+  // The same, with `held`: per DOF, nonzero = constrained in every solve until the next
+  // set_matrix (free pieces held where they came free). A held piece that hangs on the rest by
+  // a node or an edge makes A singular; a preconditioner built without the held DOFs does not
+  // see it (cpu_cg_solver.cpp). Default: held is ignored.
+  virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held) {
+    (void)held;
+    set_matrix(a);
+  }
   virtual CgResult solve(const Vector& b, Vector& x, const std::vector<std::uint8_t>& constrained,
                          const CgSettings& settings) = 0;
 };

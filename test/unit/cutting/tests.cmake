@@ -2,6 +2,8 @@
 list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_blade_path.cpp
   test/unit/cutting/test_cut_cases.cpp
+  test/unit/cutting/test_cut_fidelity.cpp
+  test/unit/cutting/test_cut_fidelity_gravity.cpp
   test/unit/cutting/test_cut_property.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
 )

@@ -166,6 +166,45 @@ TEST(FemCgPreconditioner, HeldFreePieceUsesShiftedCholesky) {
   EXPECT_LE((x - xd).norm(), 1e-9 * xd.norm());
 }
 
+// The same held piece, named as held (set_matrix(a, held), as the simulation does): the factor
+// is of A without its DOFs, so no shift is needed and CG takes about one iteration more than
+// the contact DOFs (docs/DESIGN.md eq. (16)).
+TEST(FemCgPreconditioner, NamedHeldPieceIsLeftOutOfTheFactor) {
+  const SparseMatrix& k = thigh_model().hybrid_matrix();
+  const int n = static_cast<int>(k.rows()), m = 12;
+  std::vector<Eigen::Triplet<double, int>> t;
+  for (int r = 0; r < n; ++r)
+    for (SparseMatrix::InnerIterator it(k, r); it; ++it) t.emplace_back(r, it.col(), it.value());
+  const double s = k.diagonal().mean();
+  for (int i = 0; i + 1 < m; ++i) {  // a path-graph Laplacian: singular (constant mode)
+    const int p = n + i, q = n + i + 1;
+    t.emplace_back(p, p, s), t.emplace_back(q, q, s);
+    t.emplace_back(p, q, -s), t.emplace_back(q, p, -s);
+  }
+  SparseMatrix a(n + m, n + m);
+  a.setFromTriplets(t.begin(), t.end());
+  Vector b = Vector::Zero(n + m);
+  b.head(n) = thigh_model().hybrid_rhs();
+  std::vector<std::uint8_t> constrained(static_cast<size_t>(n + m), 0), held = constrained;
+  Vector x0 = Vector::Zero(n + m);
+  for (int i = n; i < n + m; ++i) constrained[static_cast<size_t>(i)] = held[i] = 1, x0[i] = 1e-3;
+  const std::vector<int> contact = contact_rows(thigh_model());
+  for (int r : contact) constrained[static_cast<size_t>(r)] = 1, x0[r] = -1e-3;
+  Vector xd = x0;
+  solve_direct(a, b, xd, constrained);
+
+  auto cg = make_cpu_solver(CgPreconditioner::kCholesky);
+  cg->set_matrix(a, held);
+  EXPECT_EQ(cg->preconditioner(), "cholesky");
+  Vector x = x0;
+  const CgResult r = cg->solve(b, x, constrained, CgSettings{1e-12, 20000});
+  EXPECT_TRUE(r.converged);
+  // Exact arithmetic: #contact + 1; measured 14 for 12 contact DOFs at 1e-12 (round-off).
+  EXPECT_LE(r.iterations, static_cast<int>(contact.size()) + 2) << r.iterations;
+  EXPECT_LE((x - xd).norm(), 1e-9 * xd.norm());
+  EXPECT_THROW(cg->set_matrix(a, std::vector<std::uint8_t>(3, 1)), std::invalid_argument);
+}
+
 // No SPD factor even shifted (indefinite): Jacobi for that matrix, no crash; the next SPD
 // matrix is factored again.
 TEST(FemCgPreconditioner, IndefiniteMatrixFallsBackToJacobi) {

@@ -1,0 +1,89 @@
+#include "soft_tissue_cutting/cutting/rest_mapping.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stc {
+
+void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+                           const std::vector<std::uint8_t>& include) {
+  mesh_.nodes = mesh.nodes;
+  mesh_.tets = mesh.tets;
+  std::vector<Vec3> x(mesh.nodes.size());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = mesh.nodes[i] + displacement[i];
+  locator_.build(mesh_, x, include);
+}
+
+namespace {
+Vec3 rest_point(const TetMesh& mesh, int tet, const std::array<double, 4>& w) {
+  Vec3 r = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) r += w[k] * mesh.nodes[mesh.tets[tet][k]];
+  return r;
+}
+}  // namespace
+
+std::optional<Vec3> DeformedToRest::map(const Vec3& x) const {
+  const auto hit = locator_.locate(x, 1e-9);
+  if (!hit) return std::nullopt;
+  return rest_point(mesh_, hit->tet, hit->barycentric);
+}
+
+std::optional<std::vector<Vec3>> DeformedToRest::map_edge(const Vec3& tip, const Vec3& heel,
+                                                          const std::vector<double>& s) const {
+  const size_t n = s.size();
+  std::vector<int> tet(n, -1);
+  std::vector<Vec3> out(n);
+  std::vector<Vec3> x(n);
+  for (size_t i = 0; i < n; ++i) {
+    x[i] = tip + s[i] * (heel - tip);
+    if (const auto hit = locator_.locate(x[i], 1e-9)) {
+      tet[i] = hit->tet;
+      out[i] = rest_point(mesh_, hit->tet, hit->barycentric);
+    }
+  }
+  if (std::all_of(tet.begin(), tet.end(), [](int t) { return t < 0; })) return std::nullopt;
+  const std::vector<Vec3>& deformed = locator_.positions();
+  for (size_t i = 0; i < n; ++i) {
+    if (tet[i] >= 0) continue;
+    size_t nearest = n;
+    for (size_t j = 0; j < n; ++j)
+      if (tet[j] >= 0 && (nearest == n || std::abs(s[j] - s[i]) < std::abs(s[nearest] - s[i])))
+        nearest = j;
+    const Tet& k = mesh_.tets[tet[nearest]];
+    const auto w =
+        barycentric(deformed[k[0]], deformed[k[1]], deformed[k[2]], deformed[k[3]], x[i]);
+    out[i] = rest_point(mesh_, tet[nearest], w);
+  }
+  return out;
+}
+
+std::vector<int> simplify_polylines(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
+                                    double tolerance) {
+  const int n = static_cast<int>(a.size());
+  std::vector<char> keep(n, 0);
+  if (n == 0) return {};
+  keep[0] = keep[n - 1] = 1;
+  std::vector<std::pair<int, int>> stack = {{0, n - 1}};
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    int worst = -1;
+    double worst_d = tolerance;
+    for (int k = i + 1; k < j; ++k) {
+      const double t = static_cast<double>(k - i) / (j - i);  // samples are evenly spaced
+      const double d = std::max((a[k] - (a[i] + t * (a[j] - a[i]))).norm(),
+                                (b[k] - (b[i] + t * (b[j] - b[i]))).norm());
+      if (d > worst_d) worst_d = d, worst = k;
+    }
+    if (worst < 0) continue;
+    keep[worst] = 1;
+    stack.push_back({i, worst});
+    stack.push_back({worst, j});
+  }
+  std::vector<int> kept;
+  for (int k = 0; k < n; ++k)
+    if (keep[k]) kept.push_back(k);
+  return kept;
+}
+
+}  // namespace stc
