@@ -54,16 +54,49 @@ inline double swept_area_inside(const TetMesh& mesh, const std::vector<BladePose
   return area;
 }
 
-// max |u_sim - u_full| / max |u_full| over every DOF (interior condensed nodes recovered).
+// max |u_sim - u_full| / max |u_full| over every DOF (interior condensed nodes recovered). The
+// full model holds what the simulation holds: fixed nodes at zero, the nodes of free pieces
+// held where they came free (HybridModel::held_nodes) at the simulation's displacement, so a
+// cut-free piece (singular without them) is compared like the rest: K_ff u_f = f_f - K_fh u_h.
 inline double relative_error_vs_full_model(Simulation& sim) {
   const Vector u = sim.full_displacement();
   const HybridModel& model = sim.model();
   const ElementStiffnessCache elements(model.mesh(), model.material());
   const FullModel full =
       assemble_full_model(model.mesh(), elements, model.loads(), model.fixed_nodes());
-  const Vector u_full = SparseCholesky(full.K).solve(full.f);
+  const std::vector<std::uint8_t>& held = model.held_nodes();
+  const int rows = full.dofs.rows();
+  std::vector<int> free_row(static_cast<size_t>(rows), -1);
+  std::vector<int> free_dofs;
+  Vector u_held = Vector::Zero(rows);
+  for (int r = 0; r < rows; ++r) {
+    const int g = full.dofs.global_of[static_cast<size_t>(r)];
+    const size_t node = static_cast<size_t>(g / 3);
+    if (node < held.size() && held[node]) {
+      u_held[r] = u[g];
+    } else {
+      free_row[static_cast<size_t>(r)] = static_cast<int>(free_dofs.size());
+      free_dofs.push_back(r);
+    }
+  }
+  const Vector rhs_all = full.f - full.K * u_held;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int c = 0; c < full.K.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(full.K, c); it; ++it) {
+      const int i = free_row[static_cast<size_t>(it.row())],
+                j = free_row[static_cast<size_t>(it.col())];
+      if (i >= 0 && j >= 0) t.emplace_back(i, j, it.value());
+    }
+  const auto nf = static_cast<Eigen::Index>(free_dofs.size());
+  SparseMatrix k_ff(nf, nf);
+  k_ff.setFromTriplets(t.begin(), t.end());
+  Vector f_f(nf);
+  for (Eigen::Index i = 0; i < nf; ++i) f_f[i] = rhs_all[free_dofs[static_cast<size_t>(i)]];
+  const Vector x_f = SparseCholesky(k_ff).solve(f_f);
+  Vector u_full = u_held;
+  for (Eigen::Index i = 0; i < nf; ++i) u_full[free_dofs[static_cast<size_t>(i)]] = x_f[i];
   double err = 0, ref = 0;
-  for (int r = 0; r < full.dofs.rows(); ++r) {
+  for (int r = 0; r < rows; ++r) {
     const int g = full.dofs.global_of[static_cast<size_t>(r)];
     err = std::max(err, std::abs(u[g] - u_full[r]));
     ref = std::max(ref, std::abs(u_full[r]));

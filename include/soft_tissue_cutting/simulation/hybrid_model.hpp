@@ -123,6 +123,7 @@ class HybridModel {
   // Global load vector (3n): point loads + consistent gravity of the current mesh.
   Vector loads() const;
   const std::vector<std::uint8_t>& fixed_nodes() const { return fixed_; }
+  const std::vector<std::uint8_t>& held_nodes() const { return held_; }  // set_held_nodes
 
  private:
   void condense_and_assemble(std::chrono::steady_clock::time_point start);
