@@ -94,6 +94,9 @@ std::string run_isolated(const std::string& path, const std::string& what,
     fail(path, 0, what + " failed: cannot fork: " + std::strerror(errno));
   }
   if (pid == 0) {
+    // The child dies by the signal of its crash, whatever handlers the parent installed (a
+    // node's, a sanitizer's SEGV report, a debugger's): the parent names that signal.
+    for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::signal(sig, SIG_DFL);
     ::close(fds[0]);
     ::close(errs[0]);
     ::dup2(errs[1], STDERR_FILENO);

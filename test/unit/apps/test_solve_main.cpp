@@ -6,6 +6,7 @@
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -24,13 +25,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A scratch path of this process (test shards and other checkouts run at the same time).
+fs::path scratch(const std::string& name) {
+  return fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+}
+
 struct SolveRun {
   int exit_code;
   std::string err;
 };
 
 SolveRun run_solve(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / "tissue_solve_stderr.txt";
+  const fs::path err = scratch("tissue_solve_stderr.txt");
   const std::string cmd =
       std::string(TISSUE_SOLVE_BIN) + " " + args + " 2>" + err.string() + " >/dev/null";
   const int status = std::system(cmd.c_str());
@@ -89,7 +95,7 @@ Vtk read_output(const fs::path& path) {
 const std::string kScenes = std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/";
 
 TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
-  const fs::path dir = fs::temp_directory_path() / "tissue_solve_liver";
+  const fs::path dir = scratch("tissue_solve_liver");
   fs::create_directories(dir);
   const std::string scene_file = kScenes + "liver.yaml";
   const SolveRun r = run_solve(scene_file + " --out " + (dir / "o.vtk").string() + " --stats " +
@@ -135,7 +141,7 @@ TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
 }
 
 TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
-  const fs::path dir = fs::temp_directory_path() / "tissue_solve_thigh";
+  const fs::path dir = scratch("tissue_solve_thigh");
   fs::create_directories(dir);
   const SolveRun r = run_solve("thigh --out " + (dir / "o.vtk").string() + " --stats " +
                                (dir / "o.json").string());
@@ -175,7 +181,7 @@ TEST(SolveCli, ThighTrajectoryCutsAndKeepsVolume) {
 }
 
 TEST(SolveCli, GlBackendAgreesWithCpu) {
-  const fs::path dir = fs::temp_directory_path() / "tissue_solve_gl";
+  const fs::path dir = scratch("tissue_solve_gl");
   fs::create_directories(dir);
   const std::string scene_file = kScenes + "liver.yaml";
   ASSERT_EQ(run_solve(scene_file + " --backend cpu --out " + (dir / "cpu.vtk").string()).exit_code,
@@ -199,7 +205,7 @@ TEST(SolveCli, GlBackendAgreesWithCpu) {
 TEST(SolveCli, NonConvergedFinalSolveExits3AfterWritingOutputs) {
   // The liver on gl with max_iterations 3 cannot reach 1e-10 (Jacobi-scaled float CG): the
   // run must say so (exit 3, one line on stderr) after writing both outputs.
-  const fs::path dir = fs::temp_directory_path() / "tissue_solve_cap";
+  const fs::path dir = scratch("tissue_solve_cap");
   fs::create_directories(dir);
   const fs::path scene = dir / "capped.yaml";
   const auto write_scene = [&](int max_iterations) {
@@ -244,7 +250,7 @@ TEST(SolveCli, NonConvergedFinalSolveExits3AfterWritingOutputs) {
 }
 
 TEST(SolveCli, BadInputIsOneLineNamingTheFile) {
-  const fs::path dir = fs::temp_directory_path() / "tissue_solve_bad";
+  const fs::path dir = scratch("tissue_solve_bad");
   fs::create_directories(dir);
   const fs::path scene = dir / "bad.yaml";
   std::ofstream(scene) << "mesh: {generator: {type: thigh}}\nmaterial: {young_modulus: -5}\n";

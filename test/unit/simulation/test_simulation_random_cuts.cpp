@@ -163,7 +163,7 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
   };
   Simulation sim(scene, options);
   RandomStrokes random(20261122);
-  constexpr int kSweeps = 300;
+  constexpr int kSweeps = 200;
   const int cuts = run_random_strokes(sim, random, kSweeps, scene.operation_region.sphere.center,
                                       0.02, 0.03, 0.5);
   std::printf("random sweeps: %d of %d cut, %d tets split, %d tets, %d free pieces held\n", cuts,
@@ -172,13 +172,24 @@ TEST(SimulationRandomCuts, EverySweepKeepsSpec6AndAnSpdSystem) {
   EXPECT_EQ(held_messages, sim.counts().free_pieces_held);
 }
 
-// The same on a TetGen liver sagging under gravity (issue 9): 100 random strokes through its
-// operation part, each stroke carried to rest coordinates through the sag. After every
-// stroke: docs/SCENE.md "Cut invariants", an SPD system on the free DOF, a converged finite
-// solution. The smallest dihedral angle and the CG iterations of the solve after each stroke are
-// reported (issue 9 item 4 asks for >= 5 deg and <= 2x the uncut mesh's iterations; see README, not
-// yet met).
-TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
+// How many strokes the liver property tests cut: TISSUE_RANDOM_CUT_STROKES (./tissue test
+// --strokes N: nightly sizes, 10,000) or the CI default.
+int stroke_count(int ci_default) {
+  const char* env = std::getenv("TISSUE_RANDOM_CUT_STROKES");
+  return env ? std::atoi(env) : ci_default;
+}
+
+// The same on a TetGen liver sagging under gravity (issues 9 and 12): seeded random strokes
+// through its operation part (5k tets at the start): 300 in CI (~1.5 min), 1,000 or more
+// through TISSUE_RANDOM_CUT_STROKES (1,000 took 7 min here and passed: 517 cut, 22k tets), each
+// stroke carried to rest coordinates through the sag. After every stroke: docs/SCENE.md "Cut
+// invariants", an SPD system on the free DOF, a finite solution. The smallest dihedral angle and
+// the CG iterations of the solve after each stroke are reported after 100 strokes and at the end
+// (issue 9 item 4 asks for >= 5 deg and <= 2x the uncut mesh's iterations; see README, not yet
+// met).
+TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
+  const int strokes = stroke_count(300);
+  ASSERT_GT(strokes, 0) << "TISSUE_RANDOM_CUT_STROKES must be a positive number";
   const Scene scene = fidelity::sagging_liver();
   Simulation sim(scene);
   const double dihedral_before = mesh_quality(sim.mesh()).min_dihedral_deg;
@@ -190,7 +201,18 @@ TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
   std::vector<int> iterations;
   int not_converged = 0;
   double worst_residual = 0;
-  for (int k = 0; k < 100; ++k) {
+  const auto report = [&](int done) {
+    std::vector<int> sorted = iterations;
+    std::sort(sorted.begin(), sorted.end());
+    std::printf(
+        "TetGen liver, %d random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
+        "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d); "
+        "%d solves short of 1e-10 (worst residual %.1e)\n",
+        done, cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before,
+        mesh_quality(sim.mesh()).min_dihedral_deg, sorted[sorted.size() / 2], sorted.back(),
+        cold_iterations, not_converged, worst_residual);
+  };
+  for (int k = 0; k < strokes; ++k) {
     BladePose a, b;
     a.position = centre + 0.02 * Vec3(unit(rng), unit(rng) - 0.5, unit(rng));
     b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
@@ -210,32 +232,23 @@ TEST(SimulationRandomCuts, TetGenLiverHundredStrokesKeepSpec6) {
     not_converged += !sim.model().last_result().converged;
     worst_residual = std::max(worst_residual, sim.model().last_result().residual);
     ASSERT_TRUE(sim.model().displacement().allFinite()) << "stroke " << k;
+    if (k + 1 == 100 || k + 1 == strokes) report(k + 1);
   }
-  std::sort(iterations.begin(), iterations.end());
-  const double dihedral_after = mesh_quality(sim.mesh()).min_dihedral_deg;
-  std::printf(
-      "TetGen liver, 100 random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
-      "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d); "
-      "%d solves short of 1e-10 (worst residual %.1e)\n",
-      cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before, dihedral_after,
-      iterations[iterations.size() / 2], iterations.back(), cold_iterations, not_converged,
-      worst_residual);
-  EXPECT_GT(cuts, 30);
+  EXPECT_GT(cuts, strokes * 3 / 10);
   // Not asserted (README, known limitations): after some strokes CG stops converging (16 of
   // 100 here, the residual diverging although the free block is SPD) - the CG preconditioner
   // is factored with pieces that hang on by a node; the solver owner's to fix.
 }
 
-// The same property on a TetGen liver (config/scenes/liver2_surface.yaml, tetrahedralized from
-// config/meshes/sofa_liver2.obj): 200 seeded strokes in CI (a 1,000-stroke run takes ~20 min on
-// the 2-core CI machine, and it found a solve that stops converging at stroke 362 after 28k tets
-// were split: an open problem); TISSUE_RANDOM_CUT_STROKES=1000 or 10000 (./tissue test
-// --strokes N) runs the nightly sizes. When the operation part is cut to pieces the
-// strokes go on: every later cut must keep the same properties. The Cholesky SPD check runs
-// every 10th stroke (it dominates the run time); the other checks after every stroke.
+// The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k
+// tets tetrahedralized from config/meshes/sofa_liver2.obj, hanging from its left lobe): 40
+// seeded strokes in CI (each costs ~1.5 s here: organ-scale re-assembly and refactorization per
+// cut, see issue 10), TISSUE_RANDOM_CUT_STROKES=1000 or 10000 (./tissue test --strokes N) for the
+// nightly sizes. When the operation part is cut to pieces the strokes go on: every later cut must
+// keep the same properties. The Cholesky SPD check runs every 10th stroke (it dominates the run
+// time); the other checks after every stroke.
 TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6AndAnSpdSystem) {
-  int strokes = 200;
-  if (const char* env = std::getenv("TISSUE_RANDOM_CUT_STROKES")) strokes = std::atoi(env);
+  const int strokes = stroke_count(40);
   ASSERT_GT(strokes, 0) << "TISSUE_RANDOM_CUT_STROKES must be a positive number";
   const Scene scene =
       load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/liver2_surface.yaml");
