@@ -6,7 +6,8 @@ run in one process one test at a time; on a machine with N cores, gtest's own sh
 (GTEST_TOTAL_SHARDS / GTEST_SHARD_INDEX) runs them N at a time. catkin's run_tests wants one
 result file per test target, so the shards' XML files are merged into the one named by --xml.
 
-usage: run_gtest_shards.py --xml OUT.xml [--shards N] BINARY [gtest args...]
+usage: run_gtest_shards.py OUT.xml BINARY [gtest args...]   (TISSUE_TEST_SHARDS=N: N shards)
+Positional only: catkin's run_tests.py, which runs this command, parses options itself.
 Exit status: 0 when every shard passed, else 1. Each shard's output is printed after it ends,
 shard by shard (never interleaved).
 """
@@ -57,12 +58,11 @@ def merge(xml_files, out_path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--xml", required=True, help="the merged JUnit XML to write")
-    parser.add_argument("--shards", type=int, default=default_shards())
+    parser.add_argument("xml", help="the merged JUnit XML to write")
     parser.add_argument("binary")
     parser.add_argument("args", nargs=argparse.REMAINDER)
     a = parser.parse_args()
-    shards = max(1, a.shards)
+    shards = default_shards()
     with tempfile.TemporaryDirectory(prefix="gtest_shards_") as tmp:
         procs = []
         for i in range(shards):
