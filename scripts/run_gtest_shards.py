@@ -11,7 +11,6 @@ Positional only: catkin's run_tests.py, which runs this command, parses options 
 Exit status: 0 when every shard passed, else 1. Each shard's output is printed after it ends,
 shard by shard (never interleaved).
 """
-import argparse
 import os
 import subprocess
 import sys
@@ -57,11 +56,11 @@ def merge(xml_files, out_path):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("xml", help="the merged JUnit XML to write")
-    parser.add_argument("binary")
-    parser.add_argument("args", nargs=argparse.REMAINDER)
-    a = parser.parse_args()
+    # Plain sys.argv: the gtest arguments after BINARY are passed on untouched.
+    if len(sys.argv) < 3 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__)
+        return 2
+    out_xml, binary, extra = sys.argv[1], sys.argv[2], sys.argv[3:]
     shards = default_shards()
     with tempfile.TemporaryDirectory(prefix="gtest_shards_") as tmp:
         procs = []
@@ -69,7 +68,7 @@ def main():
             env = dict(os.environ, GTEST_TOTAL_SHARDS=str(shards), GTEST_SHARD_INDEX=str(i))
             xml = os.path.join(tmp, "shard%d.xml" % i)
             log = open(os.path.join(tmp, "shard%d.log" % i), "w+")
-            cmd = [a.binary, "--gtest_output=xml:" + xml] + a.args
+            cmd = [binary, "--gtest_output=xml:" + xml] + extra
             procs.append((subprocess.Popen(cmd, env=env, stdout=log, stderr=subprocess.STDOUT), xml, log))
         rc = 0
         xmls = []
@@ -88,16 +87,16 @@ def main():
                 rc = 1
                 print("run_gtest_shards: shard %d wrote no result (exit %d)" % (i + 1, code))
         if xmls:
-            merge(xmls, a.xml)
+            merge(xmls, out_xml)
         if len(xmls) < shards:
             # A failed case for the missing shard(s), so the merged file cannot read as a pass.
-            root = ET.parse(a.xml).getroot() if xmls else ET.Element("testsuites", name="AllTests")
+            root = ET.parse(out_xml).getroot() if xmls else ET.Element("testsuites", name="AllTests")
             suite = ET.SubElement(root, "testsuite", name="run_gtest_shards", tests="1", failures="1")
             case = ET.SubElement(suite, "testcase", name="every_shard_wrote_its_result",
                                  classname="run_gtest_shards")
             ET.SubElement(case, "failure", message="%d of %d shards wrote no result (crash?)"
                           % (shards - len(xmls), shards))
-            ET.ElementTree(root).write(a.xml, encoding="UTF-8", xml_declaration=True)
+            ET.ElementTree(root).write(out_xml, encoding="UTF-8", xml_declaration=True)
     return rc
 
 
