@@ -66,6 +66,9 @@ def main():
         procs = []
         for i in range(shards):
             env = dict(os.environ, GTEST_TOTAL_SHARDS=str(shards), GTEST_SHARD_INDEX=str(i))
+            if shards > 1:  # the shards are the parallelism: no BLAS/OpenMP threads on top
+                env.setdefault("OPENBLAS_NUM_THREADS", "1")
+                env.setdefault("OMP_NUM_THREADS", "1")
             xml = os.path.join(tmp, "shard%d.xml" % i)
             log = open(os.path.join(tmp, "shard%d.log" % i), "w+")
             cmd = [binary, "--gtest_output=xml:" + xml] + extra
