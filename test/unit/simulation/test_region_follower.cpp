@@ -165,7 +165,7 @@ StrokeResult play_stroke(Simulation& sim, const std::vector<BladePose>& poses, c
           sim.region_moves() ? sim.region_moves()->ball.center.x() : 0.0,
           sim.region_moves() ? sim.region_moves()->ball.center.y() : 0.0,
           sim.region_moves() ? sim.region_moves()->ball.center.z() : 0.0);
-    EXPECT_TRUE(s.converged) << "step " << s.step;
+    EXPECT_TRUE(s.converged) << "step " << s.step << ": " << s.solver_message;
     const auto violated = test::spec6_violations(sim);
     EXPECT_TRUE(violated.empty()) << "step " << s.step << ": " << violated.front();
     if (!violated.empty()) break;
@@ -206,11 +206,11 @@ void report(const char* name, const Simulation& sim, const StrokeResult& r) {
   const RegionMoveStats m = sim.region_moves() ? *sim.region_moves() : RegionMoveStats{};
   std::printf(
       "%s: %d tets, %d steps, %d region moves (%d failed; worker last %.1f ms, max "
-      "%.1f ms), %d steps with a move under way; opened %.2f cm^2 of %.2f cm^2 swept (%.1f %%); "
-      "largest gap "
-      "%.2f mm; vs full model %.2e\n",
+      "%.1f ms), %d steps with a move under way; %d pieces held; opened %.2f cm^2 of %.2f cm^2 "
+      "swept (%.1f %%); largest gap %.2f mm; vs full model %.2e\n",
       name, sim.counts().tets, r.steps, r.moves, m.failed, m.last_ms, m.max_ms, r.steps_waiting,
-      r.opened * 1e4, r.swept * 1e4, 100 * r.opened / r.swept, r.max_gap * 1e3, r.error_vs_full);
+      sim.counts().free_pieces_held, r.opened * 1e4, r.swept * 1e4, 100 * r.opened / r.swept,
+      r.max_gap * 1e3, r.error_vs_full);
 }
 
 // The thigh (whole tube refined, 14 cm long), a 2.5 cm ball: a 10 cm incision along it,
@@ -266,24 +266,26 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   EXPECT_LT(o.error_vs_full, 1e-9);
 }
 
-// A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 2 cm
-// ball: a 10 cm stroke along x across its top, 6 mm below the surface, edge up, against
-// `operation_region: all`.
-// DISABLED after merging the cut-fidelity work (stop 18): the run throws "sparse Cholesky
-// (CHOLMOD): matrix not positive definite" on this liver (a piece cut free while the region
-// moves is not held in some model); open under issue 16.
-TEST(FollowRegion, DISABLED_TenCentimetreStrokeAcrossATetGenLiver) {
+// A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 3 cm
+// ball: a 10 cm stroke along x across its top (9.2 cm of it on the liver), 6 mm below the
+// surface, edge up, against `operation_region: all`. Cut pieces come free on the way and are held
+// across the moves. Why 3 cm and not 2 cm: this mesh's edges are ~7 mm, and a 2 cm ball (under
+// 3 elements) cannot hold the blade's edge one element layer plus the look-ahead clear of its
+// interface, so sweeps are cut as far as the region reaches and the cut opens 74 % of `all`'s
+// (1.47 vs 1.99 cm^2); at 3 cm it opens as much as `all`. Why a solver tolerance of 1e-11: the
+// `all` reference on the cut liver stalls at a relative residual of ~1.3e-12.
+TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
   test::TempDir dir;
   const std::string path = test::write_file(
       dir.file("s.yaml"),
       "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
           "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
           "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
-          "operation_region: {follow: {radius: 0.02}}\n"
+          "operation_region: {follow: {radius: 0.03}}\n"
           "gravity: [0, -9.81, 0]\n"
           "scalpel: {blade_length: 0.02, cut_pressure: 0.01}\n"
           "trajectory: [{t: 0, position: [-0.065, 0.01, 0.768]}]\n"
-          "solver: {tolerance: 1.0e-12}\n");
+          "solver: {tolerance: 1.0e-11}\n");
   const Scene scene = load_scene(path);
   // The top surface along the stroke line (z = 0.768): the highest rest point inside.
   TetGrid grid;
@@ -333,8 +335,9 @@ TEST(FollowRegion, DISABLED_TenCentimetreStrokeAcrossATetGenLiver) {
   EXPECT_LE(f.max_gap, b.max_gap + 0.003);
   EXPECT_LT(f.error_vs_full, 1e-9);
   EXPECT_LT(b.error_vs_full, 1e-9);
-  // The liver's cut differs from `all` in a few tets (6807 vs 6818 at the time of writing):
-  // a sweep cut across a move is not always split the same way. Reported, not asserted.
+  // The liver's cut may differ from `all` by a node (both 6211 tets, different meshes, at the
+  // time of writing): a sweep is carried to rest through part 1, which differs. Reported, not
+  // asserted.
   std::printf("liver: final meshes %s\n", f.hash == b.hash ? "identical" : "differ");
 }
 
