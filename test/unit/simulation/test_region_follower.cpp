@@ -424,9 +424,9 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
 // the region moves on around the blade: every model a move builds must hold them (their nodes
 // out of its first factorization; a piece is free unless fixed nodes hold it, whatever one
 // partition's interface touches), every step must converge, and the end must equal the full
-// model. The lobe's tip itself stays attached: the cutter leaves bridges in a slice through
-// deforming tissue (it opens about as much as it sweeps, not all of it); the pieces it frees
-// are small (1-3 tets) but free all the same.
+// model. The lobe's tip itself stays attached (the cutter leaves face bridges across the slice
+// through the sagging lobe, here and with `operation_region: all` alike); the pieces the slice
+// frees are small (35 of 1-3 tets at the time of writing) but free all the same.
 TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   test::TempDir dir;
   const std::string path = test::write_file(
