@@ -83,17 +83,23 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
 }
 
 HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
-                         std::unique_ptr<LinearSolver> solver)
+                         const std::vector<int>& held_nodes, std::unique_ptr<LinearSolver> solver)
     : mesh_(from.mesh_),
       gravity_(from.gravity_),
       point_loads_(from.point_loads_),
       fixed_(from.fixed_),
+      held_(from.mesh_.nodes.size(), 0),
       elements_(from.elements_),  // at the current E: the new condensation is at scale 1
       solver_(std::move(solver)),
       settings_(from.settings_) {
   if (!solver_) throw std::invalid_argument("HybridModel: no linear solver");
   if (operation_tet.size() != static_cast<size_t>(mesh_.num_tets()))
     throw std::invalid_argument("HybridModel: one operation label per tet expected");
+  for (int n : held_nodes) {
+    if (n < 0 || n >= mesh_.num_nodes())
+      throw std::invalid_argument("HybridModel: held node out of range");
+    held_[static_cast<size_t>(n)] = 1;
+  }
   const auto start = Clock::now();
   const auto t0 = Clock::now();
   partition_ = partition_from_labels(mesh_, std::move(operation_tet));

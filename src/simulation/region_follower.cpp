@@ -1,10 +1,10 @@
 #include "simulation/region_follower.hpp"
 
 #include "collision/tissue_samples.hpp"
+#include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <exception>
 
 namespace stc {
@@ -118,18 +118,34 @@ bool RegionFollower::worth_moving_to(const Vec3& centre) const {
 }
 
 void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
-                           std::string reason) {
+                           std::vector<int> held_nodes, std::string reason) {
   if (moving()) return;
   requested_at_ = Clock::now();
   stats_.moving = true;
   stats_.last_reason = std::move(reason);
   const Sphere ball{centre, stats_.ball.radius};
   // The second core: the old model keeps solving on the caller's thread meanwhile.
-  work_ = std::async(std::launch::async, [&from, ball, keep = std::move(keep_nodes)]() {
+  work_ = std::async(std::launch::async, [&from, ball, keep = std::move(keep_nodes),
+                                          held = std::move(held_nodes)]() mutable {
     const auto t0 = Clock::now();
     MovedRegion r;
     r.centre = ball.center;
-    r.model = std::make_unique<HybridModel>(from, follow_region_labels(from.mesh(), ball, keep));
+    // The free pieces: anchored by fixed or held nodes only (any interface is the old
+    // partition's). Every node of one stays in part 1 (keep) and is held before the new
+    // model's first factorization (its rigid modes would make the hybrid matrix singular).
+    std::vector<std::uint8_t> anchored = from.fixed_nodes();
+    anchored.resize(from.mesh().nodes.size(), 0);
+    for (int n : held) anchored[static_cast<size_t>(n)] = 1;
+    for (const MeshPiece& piece : free_pieces(from.mesh(), anchored)) {
+      held.insert(held.end(), piece.nodes.begin(), piece.nodes.end());
+      r.found_pieces.push_back(static_cast<int>(piece.tets.size()));
+    }
+    std::sort(held.begin(), held.end());
+    held.erase(std::unique(held.begin(), held.end()), held.end());
+    keep.insert(keep.end(), held.begin(), held.end());
+    r.model =
+        std::make_unique<HybridModel>(from, follow_region_labels(from.mesh(), ball, keep), held);
+    r.held_nodes = std::move(held);
     const TetMesh& mesh = r.model->mesh();
     const Partition& p = r.model->partition();
     r.boundary.init(mesh, p.operation_tet);
@@ -151,7 +167,7 @@ bool RegionFollower::ready() const {
   return work_.valid() && work_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
 }
 
-std::optional<MovedRegion> RegionFollower::take() {
+std::optional<MovedRegion> RegionFollower::take(std::string* why) {
   if (!work_.valid()) return std::nullopt;
   stats_.moving = false;
   try {
@@ -163,8 +179,7 @@ std::optional<MovedRegion> RegionFollower::take() {
     return r;
   } catch (const std::exception& e) {
     ++stats_.failed;
-    std::fprintf(stderr, "soft_tissue_cutting: the operation region could not move: %s\n",
-                 e.what());
+    if (why) *why = e.what();
     return std::nullopt;
   }
 }

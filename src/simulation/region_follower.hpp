@@ -39,6 +39,12 @@ struct MovedRegion {
   TetGrid condensed_grid;              // the part-2 tets
   Vec3 centre = Vec3::Zero();          // the new ball's centre
   double ms = 0;                       // worker time
+  // Every node of a free piece (ascending), all in part 1 and held in the new model from its
+  // first factorization: the caller's held-piece nodes plus those of any piece the worker
+  // finds free against the fixed and held nodes (none expected: the simulation holds each
+  // piece as it comes free; a move must never build a singular model all the same).
+  std::vector<int> held_nodes;
+  std::vector<int> found_pieces;  // tets of each piece found free on the worker
 };
 
 // The cutter's view of a partition (same rule as make_cut_state): only part-1 tets are
@@ -77,13 +83,16 @@ class RegionFollower {
   // Starts the re-partition around `centre` and the re-condensation on a worker thread. The
   // worker reads `from`'s mesh, loads, fixed nodes and element matrices: until take(), the
   // caller must not cut or change E (solving is fine: it never writes those).
+  // keep_nodes: nodes that must stay O or I (imposed ones); held_nodes: every node of a free
+  // piece (MovedRegion::held_nodes). A piece is anchored by fixed (or held) nodes only, never
+  // by interface nodes: the interface is the old partition's, not the new one's.
   void start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
-             std::string reason);
+             std::vector<int> held_nodes, std::string reason);
   bool moving() const { return work_.valid(); }
   bool ready() const;  // the worker has finished
   // The moved region (waits for the worker if needed); nullopt if it failed (the reason
-  // goes to stderr and `failed`; the old model stays). Call adopted() once it is in use.
-  std::optional<MovedRegion> take();
+  // goes to *why and `failed`; the old model stays). Call adopted() once it is in use.
+  std::optional<MovedRegion> take(std::string* why = nullptr);
   void adopted(MovedRegion& moved);
   void dropped();  // a taken region was not used after all
   void cancel();   // waits for the worker and drops its result

@@ -266,9 +266,14 @@ struct Simulation::Impl {
     // inherited by copies: a copy of an interface node is not attached to the condensed part,
     // and a node marked anchored without an imposed displacement would count towards the
     // three anchors of a piece that in fact floats (a singular system; CG stalls).
+    // `follow`: fixed or held only, never interface (see start()): a piece whose only support
+    // is this partition's interface floats once the region moves.
     anchored = model->fixed_nodes();
-    for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
+    if (!follower)
+      for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
     for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
+    // A held piece's condensed nodes follow its held ones (`follow` only; else empty).
+    for (int n : held_piece_nodes) anchored[static_cast<size_t>(n)] = 1;
     hold_free_pieces();
     // The held nodes leave the solver's factor (a piece held by a hinge would make it
     // singular; cpu_cg_solver.cpp).
@@ -322,9 +327,9 @@ struct Simulation::Impl {
         held_piece_nodes.push_back(n);
       }
       ++free_pieces_held;
-      std::fprintf(stderr,
-                   "soft_tissue_cutting: a piece of %zu tets was cut free; it is held in place\n",
-                   piece.tets.size());
+      if (options.log)
+        options.log(LogLevel::kInfo, "a piece of " + std::to_string(piece.tets.size()) +
+                                         " tets was cut free; it is held in place");
     }
   }
 
@@ -341,7 +346,9 @@ struct Simulation::Impl {
   }
 
   void start_move(const Vec3& centre, std::string why) {
-    follower->start(*model, centre, imposed_nodes(), std::move(why));
+    std::vector<int> piece_nodes = held_piece_nodes;  // and copies a cut made of held nodes
+    for (const auto& h : held) piece_nodes.push_back(h.first);
+    follower->start(*model, centre, imposed_nodes(), std::move(piece_nodes), std::move(why));
   }
 
   bool operation_or_interface(const HybridModel& m, int n) const {
@@ -358,8 +365,13 @@ struct Simulation::Impl {
       s.region_moving = true;
       return;
     }
-    std::optional<MovedRegion> moved = follower->take();
-    if (!moved) return;
+    std::string failure;
+    std::optional<MovedRegion> moved = follower->take(&failure);
+    if (!moved) {
+      if (options.log)
+        options.log(LogLevel::kWarn, "the operation region could not move: " + failure);
+      return;
+    }
     HybridModel& next = *moved->model;
     for (const auto& h : held)  // a held node must stay imposable (the worker kept them)
       if (!operation_or_interface(next, h.first)) {
@@ -383,10 +395,27 @@ struct Simulation::Impl {
       for (int n : contact.tip_anchor()->nodes)
         release = release || !operation_or_interface(*model, n);
     if (release) contact.release();
-    // Nodes of held pieces that were condensed are part 1 now: held where they are.
+    // Nodes of held pieces that were condensed are part 1 now: held where they are (the
+    // worker built the model holding them). A piece it found free that no cut reported (none
+    // expected) is held from now on too.
+    for (int tets : moved->found_pieces) {
+      ++free_pieces_held;
+      if (options.log)
+        options.log(LogLevel::kWarn, "a piece of " + std::to_string(tets) +
+                                         " tets was found free at a region move; it is held "
+                                         "in place");
+    }
+    held_piece_nodes = std::move(moved->held_nodes);
     const Vector& u = model->operation_displacement();
     for (int n : held_piece_nodes)
       if (!held.count(n) && operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
+    std::vector<int> held_nodes;
+    held_nodes.reserve(held.size());
+    for (const auto& [n, h] : held) held_nodes.push_back(n);
+    model->set_held_nodes(held_nodes);  // the worker's set: no refactorization
+    anchored = model->fixed_nodes();
+    for (int n : held_nodes) anchored[static_cast<size_t>(n)] = 1;
+    for (int n : held_piece_nodes) anchored[static_cast<size_t>(n)] = 1;
     const Partition& p = model->partition();
     surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
                        p.operation_tet, displacements());

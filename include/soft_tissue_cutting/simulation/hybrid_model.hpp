@@ -42,7 +42,10 @@ class HybridModel {
   // Reads only what solve() never writes (mesh, loads, fixed nodes, element matrices), so it
   // may run on a worker thread while `from` keeps solving (simulation/region_follower.hpp).
   // Starts at zero displacement: set_displacement() hands the current state over.
+  // held_nodes: as set_held_nodes, but set before the hybrid matrix is first factored (a held
+  // free piece makes that matrix singular: the factor must leave its DOFs out from the start).
   HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
+              const std::vector<int>& held_nodes = {},
               std::unique_ptr<LinearSolver> solver = make_cpu_solver());
   ~HybridModel();
   HybridModel(const HybridModel&) = delete;

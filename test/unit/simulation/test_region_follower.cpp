@@ -6,6 +6,7 @@
 #include "common/follow_stroke.hpp"
 
 #include "collision/tissue_samples.hpp"
+#include "cutting/free_pieces.hpp"
 #include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
@@ -19,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 
 namespace stc {
 namespace {
@@ -139,6 +141,81 @@ TEST(FollowRegion, RepartitionedModelSolvesTheSameWithCutGeometryCondensed) {
             1e-8 * reference.reaction_force(pressed).norm());
 }
 
+// A bar fixed at one end, the ball around its middle: a cut across the whole bar inside the ball
+// frees the far end, whose outer half is condensed. That end touches only this partition's
+// interface, which holds nothing once the region moves (and here the condensed half floats with
+// it): it must be held at the cut that frees it, and the solve must stay exact.
+TEST(FollowRegion, BarCutInTwoHoldsTheEndThatOnlyTheInterfaceTouched) {
+  test::TempDir dir;
+  const Scene scene = load_scene(test::write_file(
+      dir.file("bar.yaml"),
+      "mesh: {generator: {type: box, size: [0.1, 0.02, 0.02], cells: [20, 4, 4]}}\n"
+      "fixed: [{box: {min: [-1, -1, -1], max: [0.001, 1, 1]}}]\n"
+      "operation_region: {follow: {radius: 0.02}}\n"
+      "material: {young_modulus: 1.0e6}\n"
+      "gravity: [0, -9.81, 0]\n"
+      "scalpel: {blade_length: 0.04}\n"
+      "trajectory: [{t: 0, position: [0.0525, -0.01, 0.01]}]\n"
+      "solver: {tolerance: 1.0e-12}\n"));
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation sim(scene, offline);
+  // Edge along +y across the bar's height, blade normal along x: the blade plane x = 0.0525
+  // (between node planes) sweeps along z through the whole width.
+  Eigen::Matrix3d r;
+  r.col(0) = Vec3::UnitY();
+  r.col(1) = Vec3::UnitX();
+  r.col(2) = -Vec3::UnitZ();
+  std::vector<BladePose> path;
+  test::append_line(path, Vec3(0.0525, -0.01, -0.01), Vec3(0.0525, -0.01, 0.03), 8,
+                    Eigen::Quaterniond(r));
+  const CutOutcome cut = sim.cut_along(path);
+  ASSERT_TRUE(cut.success) << cut.message;
+  int condensed_far_end = 0;
+  for (int t : sim.model().partition().condensed_tets) {
+    Vec3 c = Vec3::Zero();
+    for (int v : sim.mesh().tets[static_cast<size_t>(t)]) c += 0.25 * sim.mesh().nodes[v];
+    condensed_far_end += c.x() > 0.0525;
+  }
+  const StepStats s = sim.step(std::nullopt);
+  const double error = test::relative_error_vs_full_model(sim);
+  const int moves = sim.region_moves()->moves;
+  // What a move's worker builds: a re-partition around the fixed end holding the free end's
+  // nodes factors the hybrid matrix without them (SPD, no shift); without them it cannot.
+  const std::vector<MeshPiece> free = free_pieces(sim.mesh(), sim.model().fixed_nodes());
+  ASSERT_EQ(free.size(), 1u);
+  const Sphere fixed_end{Vec3(0.0125, 0.01, 0.01), 0.02};
+  const auto labels = follow_region_labels(sim.mesh(), fixed_end, free[0].nodes);
+  const HybridModel holding(sim.model(), labels, free[0].nodes);
+  const HybridModel not_holding(sim.model(), labels);
+  EXPECT_EQ(holding.solver().preconditioner(), "cholesky");
+  EXPECT_NE(not_holding.solver().preconditioner(), "cholesky");
+  // Then the blade comes down on the bar near its fixed end: the region moves there, and the
+  // new model must hold the free end (all of it in part 1 now) from its first factorization.
+  std::vector<BladePose> press;
+  test::append_line(press, Vec3(0.0125, 0.03, 0.01), Vec3(0.0125, 0.0195, 0.01), 10,
+                    Eigen::Quaterniond(r));
+  for (const BladePose& p : press) EXPECT_TRUE(sim.step(p).converged);
+  const StepStats after = sim.step(std::nullopt);
+  const double error_after = test::relative_error_vs_full_model(sim);
+  int held = 0;
+  for (std::uint8_t h : sim.model().held_nodes()) held += h;
+  std::printf(
+      "bar cut in two: %d tets of the free end condensed, %d pieces held, %d moves, vs full "
+      "model %.2e; after the press %d moves, %d nodes held, vs full model %.2e\n",
+      condensed_far_end, sim.counts().free_pieces_held, moves, error, sim.region_moves()->moves,
+      held, error_after);
+  EXPECT_GT(condensed_far_end, 0) << "the free end must reach into the condensed part";
+  EXPECT_EQ(sim.counts().free_pieces_held, 1);
+  EXPECT_TRUE(s.converged) << s.solver_message;
+  EXPECT_LT(error, 1e-9);
+  EXPECT_GT(sim.region_moves()->moves, moves);
+  EXPECT_EQ(sim.region_moves()->failed, 0);
+  EXPECT_TRUE(after.converged) << after.solver_message;
+  EXPECT_TRUE(sim.full_displacement().allFinite());
+  EXPECT_LT(error_after, 1e-9);
+}
+
 struct StrokeResult {
   int steps = 0, moves = 0, steps_waiting = 0;
   double opened = 0, swept = 0, error_vs_full = 0, max_gap = 0;
@@ -165,7 +242,7 @@ StrokeResult play_stroke(Simulation& sim, const std::vector<BladePose>& poses, c
           sim.region_moves() ? sim.region_moves()->ball.center.x() : 0.0,
           sim.region_moves() ? sim.region_moves()->ball.center.y() : 0.0,
           sim.region_moves() ? sim.region_moves()->ball.center.z() : 0.0);
-    EXPECT_TRUE(s.converged) << "step " << s.step;
+    EXPECT_TRUE(s.converged) << "step " << s.step << ": " << s.solver_message;
     const auto violated = test::spec6_violations(sim);
     EXPECT_TRUE(violated.empty()) << "step " << s.step << ": " << violated.front();
     if (!violated.empty()) break;
@@ -206,11 +283,11 @@ void report(const char* name, const Simulation& sim, const StrokeResult& r) {
   const RegionMoveStats m = sim.region_moves() ? *sim.region_moves() : RegionMoveStats{};
   std::printf(
       "%s: %d tets, %d steps, %d region moves (%d failed; worker last %.1f ms, max "
-      "%.1f ms), %d steps with a move under way; opened %.2f cm^2 of %.2f cm^2 swept (%.1f %%); "
-      "largest gap "
-      "%.2f mm; vs full model %.2e\n",
+      "%.1f ms), %d steps with a move under way; %d pieces held; opened %.2f cm^2 of %.2f cm^2 "
+      "swept (%.1f %%); largest gap %.2f mm; vs full model %.2e\n",
       name, sim.counts().tets, r.steps, r.moves, m.failed, m.last_ms, m.max_ms, r.steps_waiting,
-      r.opened * 1e4, r.swept * 1e4, 100 * r.opened / r.swept, r.max_gap * 1e3, r.error_vs_full);
+      sim.counts().free_pieces_held, r.opened * 1e4, r.swept * 1e4, 100 * r.opened / r.swept,
+      r.max_gap * 1e3, r.error_vs_full);
 }
 
 // The thigh (whole tube refined, 14 cm long), a 2.5 cm ball: a 10 cm incision along it,
@@ -266,24 +343,26 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   EXPECT_LT(o.error_vs_full, 1e-9);
 }
 
-// A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 2 cm
-// ball: a 10 cm stroke along x across its top, 6 mm below the surface, edge up, against
-// `operation_region: all`.
-// DISABLED after merging the cut-fidelity work (stop 18): the run throws "sparse Cholesky
-// (CHOLMOD): matrix not positive definite" on this liver (a piece cut free while the region
-// moves is not held in some model); open under issue 16.
-TEST(FollowRegion, DISABLED_TenCentimetreStrokeAcrossATetGenLiver) {
+// A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 3 cm
+// ball: a 10 cm stroke along x across its top (9.2 cm of it on the liver), 6 mm below the
+// surface, edge up, against `operation_region: all`. Cut pieces come free on the way and are held
+// across the moves. Why 3 cm and not 2 cm: this mesh's edges are ~7 mm, and a 2 cm ball (under
+// 3 elements) cannot hold the blade's edge one element layer plus the look-ahead clear of its
+// interface, so sweeps are cut as far as the region reaches and the cut opens 74 % of `all`'s
+// (1.47 vs 1.99 cm^2); at 3 cm it opens as much as `all`. Why a solver tolerance of 1e-11: the
+// `all` reference on the cut liver stalls at a relative residual of ~1.3e-12.
+TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
   test::TempDir dir;
   const std::string path = test::write_file(
       dir.file("s.yaml"),
       "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
           "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
           "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
-          "operation_region: {follow: {radius: 0.02}}\n"
+          "operation_region: {follow: {radius: 0.03}}\n"
           "gravity: [0, -9.81, 0]\n"
           "scalpel: {blade_length: 0.02, cut_pressure: 0.01}\n"
           "trajectory: [{t: 0, position: [-0.065, 0.01, 0.768]}]\n"
-          "solver: {tolerance: 1.0e-12}\n");
+          "solver: {tolerance: 1.0e-11}\n");
   const Scene scene = load_scene(path);
   // The top surface along the stroke line (z = 0.768): the highest rest point inside.
   TetGrid grid;
@@ -333,9 +412,127 @@ TEST(FollowRegion, DISABLED_TenCentimetreStrokeAcrossATetGenLiver) {
   EXPECT_LE(f.max_gap, b.max_gap + 0.003);
   EXPECT_LT(f.error_vs_full, 1e-9);
   EXPECT_LT(b.error_vs_full, 1e-9);
-  // The liver's cut differs from `all` in a few tets (6807 vs 6818 at the time of writing):
-  // a sweep cut across a move is not always split the same way. Reported, not asserted.
+  // The liver's cut may differ from `all` by a node (both 6211 tets, different meshes, at the
+  // time of writing): a sweep is carried to rest through part 1, which differs. Reported, not
+  // asserted.
   std::printf("liver: final meshes %s\n", f.hash == b.hash ? "identical" : "differ");
+}
+
+// The TetGen liver's thin lobe (x > 0.018, y from -0.045 to -0.018, not fixed), a 3 cm ball: a
+// vertical blade slices across the lobe along z through its whole (sagging) thickness, then a
+// second stroke runs 4 cm along the top of the body. The slice cuts pieces free mid-stroke while
+// the region moves on around the blade: every model a move builds must hold them (their nodes
+// out of its first factorization; a piece is free unless fixed nodes hold it, whatever one
+// partition's interface touches), every step must converge, and the end must equal the full
+// model. The lobe's tip itself stays attached (the cutter leaves face bridges across the slice
+// through the sagging lobe, here and with `operation_region: all` alike); the pieces the slice
+// frees are small (35 of 1-3 tets at the time of writing) but free all the same.
+TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
+  test::TempDir dir;
+  const std::string path = test::write_file(
+      dir.file("s.yaml"),
+      "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
+          "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
+          "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
+          "operation_region: {follow: {radius: 0.03}}\n"
+          "gravity: [0, -9.81, 0]\n"
+          "scalpel: {blade_length: 0.06, cut_pressure: 0.01}\n"
+          "trajectory: [{t: 0, position: [0.018, -0.07, 0.75]}]\n"
+          "solver: {tolerance: 1.0e-11}\n");
+  const Scene scene = load_scene(path);
+  std::vector<BladePose> lobe, top;
+  {  // Edge up (+y) from below the lobe to above it, blade normal along x: the blade plane
+     // holds the z motion; 0.5 mm per step from one side of the lobe to the other.
+    Eigen::Matrix3d r;
+    r.col(0) = Vec3::UnitY();
+    r.col(1) = Vec3::UnitX();
+    r.col(2) = -Vec3::UnitZ();
+    const Eigen::Quaterniond q(r);
+    const Vec3 from(0.018, -0.07, 0.75), to(0.018, -0.07, 0.792);
+    test::append_line(lobe, from, from, 1, q);
+    test::append_line(lobe, from, to, 84, q);
+  }
+  {  // Then 4 cm along -x on the top of the body, 6 mm deep, edge up (as the 10 cm stroke).
+    Eigen::Matrix3d r;
+    r.col(0) = Vec3::UnitY();
+    r.col(1) = Vec3::UnitZ();
+    r.col(2) = Vec3::UnitX();
+    const Eigen::Quaterniond q(r);
+    TetGrid grid;
+    grid.build(scene.mesh, {});
+    auto surface = [&](double x) {
+      for (double y = 0.01; y > -0.05; y -= 0.0002)
+        if (tet_containing(scene.mesh, grid, Vec3(x, y, 0.768)) >= 0) return y;
+      return std::numeric_limits<double>::quiet_NaN();
+    };
+    const double depth = 0.006, x0 = 0.0, x1 = -0.04;
+    const Vec3 above(x0, surface(x0) + 0.005, 0.768), in(x0, surface(x0) - depth, 0.768);
+    test::append_line(top, above, above, 1, q);
+    test::append_line(top, above, in, 20, q);
+    Vec3 last = in;
+    for (int k = 1; k <= 80; ++k) {
+      const double x = x0 + (x1 - x0) * k / 80;
+      const Vec3 next(x, surface(x) - depth, 0.768);
+      ASSERT_TRUE(next.allFinite()) << "off the liver at x " << x;
+      test::append_line(top, last, next, 1, q);
+      last = next;
+    }
+    test::append_line(top, last, last + Vec3(0, 0.03, 0), 20, q);
+  }
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  int logged_pieces = 0, found_at_moves = 0;
+  offline.log = [&](LogLevel, const std::string& m) {
+    logged_pieces += m.find("cut free") != std::string::npos;
+    found_at_moves += m.find("found free at a region move") != std::string::npos;
+  };
+  Simulation sim(scene, offline);
+  int steps = 0, unconverged = 0, first_held_step = -1, moves_before = 0;
+  bool keeps_invariants = true;
+  auto play = [&](const std::optional<BladePose>& pose) {
+    const StepStats s = sim.step(pose);
+    ++steps;
+    unconverged += !s.converged;
+    EXPECT_TRUE(s.converged) << "step " << s.step << ": " << s.solver_message;
+    if (first_held_step < 0 && sim.counts().free_pieces_held > 0) {
+      first_held_step = steps;
+      moves_before = sim.region_moves()->moves;
+    }
+    const auto violated = test::spec6_violations(sim);
+    if (keeps_invariants && !violated.empty()) {
+      keeps_invariants = false;
+      ADD_FAILURE() << "step " << s.step << ": " << violated.front();
+    }
+  };
+  for (const BladePose& p : lobe) play(p);
+  const int lobe_steps = steps;
+  for (int k = 0; k < 3; ++k) play(std::nullopt);
+  for (const BladePose& p : top) play(p);
+  sim.settle_region_move();
+  play(std::nullopt);
+  const Vector u = sim.full_displacement();
+  const double error = test::relative_error_vs_full_model(sim);
+  const RegionMoveStats& m = *sim.region_moves();
+  int held_nodes = 0;
+  for (std::uint8_t h : sim.model().held_nodes()) held_nodes += h;
+  std::printf(
+      "liver, pieces cut free: %d steps (%d slicing the lobe), %d pieces held (the first at "
+      "step %d, after %d of %d region moves; %d failed), %d nodes held in the last model, %d "
+      "unconverged, max |u| %.2f mm, vs full model %.2e\n",
+      steps, lobe_steps, sim.counts().free_pieces_held, first_held_step, moves_before, m.moves,
+      m.failed, held_nodes, unconverged, 1e3 * u.cwiseAbs().maxCoeff(), error);
+  ASSERT_GE(first_held_step, 0) << "the slice must cut a piece free";
+  EXPECT_LE(first_held_step, lobe_steps) << "cut free mid-stroke, while slicing the lobe";
+  EXPECT_EQ(logged_pieces, sim.counts().free_pieces_held) << "each reported on the log sink";
+  // Each held by the cut that frees it, not only by the next move's model: whatever this
+  // partition's interface touches does not hold a piece once the region moves.
+  EXPECT_EQ(found_at_moves, 0);
+  EXPECT_GE(m.moves - moves_before, 3) << "the region must move on with the pieces held";
+  EXPECT_EQ(m.failed, 0);
+  EXPECT_GT(held_nodes, 0);
+  EXPECT_EQ(unconverged, 0);
+  EXPECT_TRUE(u.allFinite());
+  EXPECT_LT(error, 1e-9);
 }
 
 }  // namespace
