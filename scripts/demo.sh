@@ -4,9 +4,12 @@
 # `trajectory`) + a bag recording, stopped with SIGINT so the bag closes cleanly; then a summary
 # from the bag, `rosbag info`, and a picture of the cut tissue rendered by rviz under Xvfb.
 # SCENE: `thigh` (default, the built-in scene), the name of a scene in config/scenes/ (e.g.
-# `liver`) or a scene YAML path. Writes ONLY under out/demo/ (git-ignored: demo.bag, logs,
-# cut_tissue.png); `./tissue pictures` is what refreshes the README's pictures in docs/.
-# Environment: TISSUE_DEMO_SECONDS (default 12), TISSUE_DEMO_PICTURE=0 skips the picture.
+# `liver_cut`) or a scene YAML path. The picture frames the scene's own incision
+# (scripts/picture_view.py; the thigh: config/tissue.rviz's view). Writes ONLY under out/demo/
+# (git-ignored: demo.bag, logs, cut_tissue.png); `./tissue pictures` is what refreshes the
+# README's pictures in docs/. Environment: TISSUE_DEMO_SECONDS (default: 12, or the scene's
+# trajectory at demo.launch's speed 0.25 plus 8 s when that is longer), TISSUE_DEMO_PICTURE=0
+# skips the picture.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$ROOT/out/demo"
@@ -37,7 +40,17 @@ fi
 if [ "$scene" != thigh ] && ! grep -qE '^trajectory:' "$scene"; then
   echo "demo: note: $(basename "$scene") has no 'trajectory': the node runs without a scalpel"
 fi
-seconds="${TISSUE_DEMO_SECONDS:-12}"
+# Long enough for the node to start (TetGen, condensation), the player's 1 s delay and the
+# whole trajectory at speed 0.25 (demo.launch): 12 s for the thigh's 1 s stroke.
+default_seconds=12
+if [ "$scene" != thigh ]; then
+  default_seconds=$(/usr/bin/python3 -c '
+import math, sys, yaml
+poses = (yaml.safe_load(open(sys.argv[1])) or {}).get("trajectory") or []
+end = max((float(p["t"]) for p in poses), default=0.0)
+print(max(12, math.ceil(end / 0.25 + 8)))' "$scene")
+fi
+seconds="${TISSUE_DEMO_SECONDS:-$default_seconds}"
 bag="$OUT/demo.bag"
 rm -f "$bag" "$bag.active"
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
@@ -64,6 +77,19 @@ stats = [m for _, m, _ in bag.read_messages(topics=["/tissue/stats"])]
 wrench = [m for _, m, _ in bag.read_messages(topics=["/tissue/scalpel/wrench"])]
 poses = bag.get_message_count("/scalpel/pose")
 hashes = [m.data for _, m, _ in bag.read_messages(topics=["/tissue/mesh_hash"])]
+# The cut faces as last shown (namespace cut_faces of ~markers: both lips, deformed).
+cut_faces = None
+for _, m, _ in bag.read_messages(topics=["/tissue/markers"]):
+    cut_faces = next((k for k in m.markers if k.ns == "cut_faces"), cut_faces)
+def triangles_area(points):
+    area = 0.0
+    for a, b, c in zip(points[0::3], points[1::3], points[2::3]):
+        u = (b.x - a.x, b.y - a.y, b.z - a.z)
+        v = (c.x - a.x, c.y - a.y, c.z - a.z)
+        n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+        area += 0.5 * (n[0] ** 2 + n[1] ** 2 + n[2] ** 2) ** 0.5
+    return area
+cut_area = triangles_area(cut_faces.points) if cut_faces and cut_faces.action == 0 else 0.0
 if not stats:
     sys.exit("demo: no /tissue/stats in the bag")
 last = stats[-1]
@@ -74,6 +100,7 @@ print(f"  steps             {len(stats)} (last step {last.step})")
 print(f"  scalpel poses     {poses}")
 print(f"  cuts              {last.cuts}  (tets split {last.tets_split}, first cut at step {first_cut})")
 print(f"  tets              {stats[0].tets} -> {last.tets}, nodes {stats[0].nodes} -> {last.nodes}")
+print(f"  open cut faces    {cut_area * 1e4:.1f} cm2 (both lips, deformed)")
 print(f"  median step       {statistics.median(s.step_ms for s in stats):.3f} ms "
       f"(max {max(s.step_ms for s in stats):.3f} ms)")
 print(f"  achieved rate     {statistics.median(s.rate_hz for s in stats):.1f} Hz (median)")
@@ -87,7 +114,8 @@ rosbag info "$bag"
 
 if [ "${TISSUE_DEMO_PICTURE:-1}" != 0 ]; then
   echo "demo: rendering the cut tissue with rviz under Xvfb"
-  if "$ROOT/scripts/render_picture.sh" "$bag" "$OUT/cut_tissue.png" >"$OUT/render.log" 2>&1; then
+  if "$ROOT/scripts/render_picture.sh" "$bag" "$OUT/cut_tissue.png" "$scene" \
+    >"$OUT/render.log" 2>&1; then
     echo "demo: picture out/demo/cut_tissue.png"
   else
     tail -10 "$OUT/render.log"

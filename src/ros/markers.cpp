@@ -10,7 +10,8 @@ namespace ros_io {
 namespace {
 
 // Fixed light, roughly from where config/tissue.rviz's camera looks at the thigh's operation
-// region (+x side, a little above), so the lit side faces the viewer.
+// region (+x side, a little above), so the lit side faces the viewer. scripts/picture_view.py
+// (MARKER_LIGHT) places a scene's picture camera on the lit side: keep the two the same.
 const Vec3 kLight = Vec3(1.0, 0.35, 0.6).normalized();
 constexpr double kAmbient = 0.35;
 
