@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <limits>
 #include <optional>
+#include <sstream>
 
 namespace stc {
 namespace {
@@ -343,6 +344,39 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   EXPECT_LT(o.error_vs_full, 1e-9);
 }
 
+// The TetGen liver of the follow tests: sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`
+// (5.7k tets), its underside fixed, under gravity, a 3 cm follow ball.
+Scene follow_liver_scene(const test::TempDir& dir, double blade_length, const Vec3& start) {
+  std::ostringstream yaml;
+  yaml << "mesh: {file: " << TISSUE_SHARED_MESH_DIR
+       << "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
+          "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
+          "operation_region: {follow: {radius: 0.03}}\n"
+          "gravity: [0, -9.81, 0]\n"
+          "scalpel: {blade_length: "
+       << blade_length << ", cut_pressure: 0.01}\n"
+       << "trajectory: [{t: 0, position: [" << start.x() << ", " << start.y() << ", " << start.z()
+       << "]}]\n"
+       << "solver: {tolerance: 1.0e-11}\n";
+  return load_scene(test::write_file(dir.file("s.yaml"), yaml.str()));
+}
+
+// The highest rest point of the liver above (x, z): its top surface along a stroke line.
+double liver_top(const TetMesh& mesh, const TetGrid& grid, double x, double z) {
+  for (double y = 0.01; y > -0.05; y -= 0.0002)
+    if (tet_containing(mesh, grid, Vec3(x, y, z)) >= 0) return y;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// A blade orientation from its edge (tip to heel), blade normal and travel directions.
+Eigen::Quaterniond blade_frame(const Vec3& edge, const Vec3& normal, const Vec3& travel) {
+  Eigen::Matrix3d r;
+  r.col(0) = edge;
+  r.col(1) = normal;
+  r.col(2) = travel;
+  return Eigen::Quaterniond(r);
+}
+
 // A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 3 cm
 // ball: a 10 cm stroke along x across its top (9.2 cm of it on the liver), 6 mm below the
 // surface, edge up, against `operation_region: all`. Cut pieces come free on the way and are held
@@ -353,31 +387,12 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
 // `all` reference on the cut liver stalls at a relative residual of ~1.3e-12.
 TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
   test::TempDir dir;
-  const std::string path = test::write_file(
-      dir.file("s.yaml"),
-      "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
-          "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
-          "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
-          "operation_region: {follow: {radius: 0.03}}\n"
-          "gravity: [0, -9.81, 0]\n"
-          "scalpel: {blade_length: 0.02, cut_pressure: 0.01}\n"
-          "trajectory: [{t: 0, position: [-0.065, 0.01, 0.768]}]\n"
-          "solver: {tolerance: 1.0e-11}\n");
-  const Scene scene = load_scene(path);
-  // The top surface along the stroke line (z = 0.768): the highest rest point inside.
+  const Scene scene = follow_liver_scene(dir, 0.02, Vec3(-0.065, 0.01, 0.768));
   TetGrid grid;
   grid.build(scene.mesh, {});
-  auto top = [&](double x) {
-    for (double y = 0.01; y > -0.05; y -= 0.0002)
-      if (tet_containing(scene.mesh, grid, Vec3(x, y, 0.768)) >= 0) return y;
-    return std::numeric_limits<double>::quiet_NaN();
-  };
+  auto top = [&](double x) { return liver_top(scene.mesh, grid, x, 0.768); };
   // Edge along world +y (up), blade normal along world z: the blade plane holds the x motion.
-  Eigen::Matrix3d r;
-  r.col(0) = Vec3::UnitY();
-  r.col(1) = Vec3::UnitZ();
-  r.col(2) = Vec3::UnitX();
-  const Eigen::Quaterniond q(r);
+  const Eigen::Quaterniond q = blade_frame(Vec3::UnitY(), Vec3::UnitZ(), Vec3::UnitX());
   const double depth = 0.006, x0 = -0.065, x1 = 0.035;
   ASSERT_FALSE(std::isnan(top(x0)));
   std::vector<BladePose> poses;
@@ -429,42 +444,20 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
 // frees are small (35 of 1-3 tets at the time of writing) but free all the same.
 TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   test::TempDir dir;
-  const std::string path = test::write_file(
-      dir.file("s.yaml"),
-      "mesh: {file: " + std::string(TISSUE_SHARED_MESH_DIR) +
-          "/sofa_liver2.obj, scale: 0.05, tetgen: {switches: \"pQ\"}}\n"
-          "fixed: [{box: {min: [-0.08, -0.06, 0.71], max: [0.04, -0.047, 0.79]}}]\n"
-          "operation_region: {follow: {radius: 0.03}}\n"
-          "gravity: [0, -9.81, 0]\n"
-          "scalpel: {blade_length: 0.06, cut_pressure: 0.01}\n"
-          "trajectory: [{t: 0, position: [0.018, -0.07, 0.75]}]\n"
-          "solver: {tolerance: 1.0e-11}\n");
-  const Scene scene = load_scene(path);
+  const Scene scene = follow_liver_scene(dir, 0.06, Vec3(0.018, -0.07, 0.75));
   std::vector<BladePose> lobe, top;
   {  // Edge up (+y) from below the lobe to above it, blade normal along x: the blade plane
      // holds the z motion; 0.5 mm per step from one side of the lobe to the other.
-    Eigen::Matrix3d r;
-    r.col(0) = Vec3::UnitY();
-    r.col(1) = Vec3::UnitX();
-    r.col(2) = -Vec3::UnitZ();
-    const Eigen::Quaterniond q(r);
+    const Eigen::Quaterniond q = blade_frame(Vec3::UnitY(), Vec3::UnitX(), -Vec3::UnitZ());
     const Vec3 from(0.018, -0.07, 0.75), to(0.018, -0.07, 0.792);
     test::append_line(lobe, from, from, 1, q);
     test::append_line(lobe, from, to, 84, q);
   }
   {  // Then 4 cm along -x on the top of the body, 6 mm deep, edge up (as the 10 cm stroke).
-    Eigen::Matrix3d r;
-    r.col(0) = Vec3::UnitY();
-    r.col(1) = Vec3::UnitZ();
-    r.col(2) = Vec3::UnitX();
-    const Eigen::Quaterniond q(r);
+    const Eigen::Quaterniond q = blade_frame(Vec3::UnitY(), Vec3::UnitZ(), Vec3::UnitX());
     TetGrid grid;
     grid.build(scene.mesh, {});
-    auto surface = [&](double x) {
-      for (double y = 0.01; y > -0.05; y -= 0.0002)
-        if (tet_containing(scene.mesh, grid, Vec3(x, y, 0.768)) >= 0) return y;
-      return std::numeric_limits<double>::quiet_NaN();
-    };
+    auto surface = [&](double x) { return liver_top(scene.mesh, grid, x, 0.768); };
     const double depth = 0.006, x0 = 0.0, x1 = -0.04;
     const Vec3 above(x0, surface(x0) + 0.005, 0.768), in(x0, surface(x0) - depth, 0.768);
     test::append_line(top, above, above, 1, q);
