@@ -21,4 +21,22 @@ int closed_cut_faces(const TetMesh& mesh) {
   return (sides - open) / 2;
 }
 
+SparseMatrix free_block(const HybridModel& model, const std::vector<std::uint8_t>& held_node) {
+  const DofMap& dofs = model.hybrid_dofs();
+  std::vector<int> keep(static_cast<size_t>(dofs.rows()), -1);
+  int rows = 0;
+  for (int r = 0; r < dofs.rows(); ++r) {
+    const size_t node = static_cast<size_t>(dofs.global_of[static_cast<size_t>(r)] / 3);
+    if (node >= held_node.size() || !held_node[node]) keep[static_cast<size_t>(r)] = rows++;
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  const SparseMatrix& a = model.hybrid_matrix();
+  for (int r = 0; r < a.outerSize(); ++r)
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
+      if (keep[r] >= 0 && keep[it.col()] >= 0) t.emplace_back(keep[r], keep[it.col()], it.value());
+  SparseMatrix out(rows, rows);
+  out.setFromTriplets(t.begin(), t.end());
+  return out;
+}
+
 }  // namespace stc::test

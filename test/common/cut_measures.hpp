@@ -3,6 +3,10 @@
 #pragma once
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
+#include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+
+#include <cstdint>
+#include <vector>
 
 namespace stc::test {
 
@@ -12,5 +16,9 @@ double open_cut_area(const TetMesh& mesh);
 
 // Number of cut faces still closed (marked, shared by two tets): a crack front waiting.
 int closed_cut_faces(const TetMesh& mesh);
+
+// The hybrid matrix without the rows and columns of the DOFs of held nodes (`held_node`: one
+// flag per mesh node; the nodes of free pieces): the block that must stay SPD after a cut.
+SparseMatrix free_block(const HybridModel& model, const std::vector<std::uint8_t>& held_node);
 
 }  // namespace stc::test

@@ -27,26 +27,6 @@ namespace {
 const std::string kScene =
     std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/liver_cut.yaml";
 
-// The hybrid matrix without the rows and columns of held DOFs (free pieces): what must be SPD.
-SparseMatrix free_block(const HybridModel& model) {
-  const std::vector<std::uint8_t>& held = model.held_nodes();
-  const DofMap& dofs = model.hybrid_dofs();
-  std::vector<int> keep(static_cast<size_t>(dofs.rows()), -1);
-  int rows = 0;
-  for (int r = 0; r < dofs.rows(); ++r) {
-    const size_t node = static_cast<size_t>(dofs.global_of[static_cast<size_t>(r)] / 3);
-    if (node >= held.size() || !held[node]) keep[static_cast<size_t>(r)] = rows++;
-  }
-  std::vector<Eigen::Triplet<double>> t;
-  const SparseMatrix& a = model.hybrid_matrix();
-  for (int r = 0; r < a.outerSize(); ++r)
-    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
-      if (keep[r] >= 0 && keep[it.col()] >= 0) t.emplace_back(keep[r], keep[it.col()], it.value());
-  SparseMatrix out(rows, rows);
-  out.setFromTriplets(t.begin(), t.end());
-  return out;
-}
-
 // How far the incision gapes: over the nodes of open cut faces, the largest deformed distance
 // between two nodes a cut made of one (same rest position).
 double widest_gap(const TetMesh& mesh, const std::vector<Vec3>& deformed) {
@@ -126,7 +106,8 @@ TEST(LiverCutScene, PressesYieldsAndOpensAGapingIncision) {
   EXPECT_TRUE(violated.empty()) << violated.size() << " violated, first: " << violated.front();
   const SparseMatrix& a = sim.model().hybrid_matrix();
   EXPECT_LE((SparseMatrix(a.transpose()) - a).norm(), 1e-12 * a.norm());
-  EXPECT_NO_THROW(SparseCholesky{free_block(sim.model())}) << "free block not SPD";
+  EXPECT_NO_THROW(SparseCholesky{test::free_block(sim.model(), sim.model().held_nodes())})
+      << "free block not SPD";
 
   // Every solve converged; the outputs are finite.
   EXPECT_TRUE(unconverged.str().empty()) << unconverged.str();

@@ -4,6 +4,7 @@
 // definite on the free DOF (held pieces excluded: they are constrained), a converged finite
 // solution.
 #include "common/cut_fidelity_scenes.hpp"
+#include "common/cut_measures.hpp"
 #include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
@@ -24,15 +25,22 @@
 namespace stc {
 namespace {
 
-// The held DOFs of the hybrid system (the nodes of free pieces, as free_block excludes them).
-std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
+// The nodes of free pieces, found again here (anchored by fixed and interface nodes): what
+// must be held for the rest of the hybrid system to stay SPD.
+std::vector<std::uint8_t> held_nodes(const Simulation& sim) {
   const HybridModel& model = sim.model();
   std::vector<std::uint8_t> anchored = model.fixed_nodes();
   for (int i : model.partition().interface) anchored[static_cast<size_t>(i)] = 1;
   std::vector<std::uint8_t> held(anchored.size(), 0);
   for (const MeshPiece& piece : free_pieces(model.mesh(), anchored))
     for (int n : piece.nodes) held[static_cast<size_t>(n)] = 1;
-  const DofMap& dofs = model.hybrid_dofs();
+  return held;
+}
+
+// The held DOFs of the hybrid system (the rows free_block leaves out).
+std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
+  const std::vector<std::uint8_t> held = held_nodes(sim);
+  const DofMap& dofs = sim.model().hybrid_dofs();
   std::vector<std::uint8_t> out(static_cast<size_t>(dofs.rows()), 0);
   for (int r = 0; r < dofs.rows(); ++r)
     out[static_cast<size_t>(r)] =
@@ -40,21 +48,8 @@ std::vector<std::uint8_t> held_dofs(const Simulation& sim) {
   return out;
 }
 
-// The hybrid matrix restricted to the DOFs that are not held.
 SparseMatrix free_block(const Simulation& sim) {
-  const std::vector<std::uint8_t> held = held_dofs(sim);
-  std::vector<int> keep(held.size(), -1);
-  int rows = 0;
-  for (size_t r = 0; r < held.size(); ++r)
-    if (!held[r]) keep[r] = rows++;
-  std::vector<Eigen::Triplet<double>> t;
-  const SparseMatrix& a = sim.model().hybrid_matrix();
-  for (int r = 0; r < a.outerSize(); ++r)
-    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
-      if (keep[r] >= 0 && keep[it.col()] >= 0) t.emplace_back(keep[r], keep[it.col()], it.value());
-  SparseMatrix out(rows, rows);
-  out.setFromTriplets(t.begin(), t.end());
-  return out;
+  return test::free_block(sim.model(), held_nodes(sim));
 }
 
 // Why a solve did not converge: the preconditioner that was active, the solver's message, the
