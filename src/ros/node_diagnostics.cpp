@@ -3,17 +3,25 @@
 // or stall in between is reported once) plus the backend in use. It never takes the simulation
 // lock, so it keeps publishing while the simulation is busy, and a stalled loop shows up as an
 // ERROR.
+#include "soft_tissue_cutting/ros/heap_release.hpp"
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 namespace stc {
 namespace ros_io {
 
 void TissueNode::diagnostics_thread() {
+  auto next_release = std::chrono::steady_clock::now();
   while (running_ && ros::ok()) {
     diagnostics_.update();  // publishes once per its period (1 s)
+    // What cuts free inside the heaps goes back to the system every 10 s, off the loop.
+    if (std::chrono::steady_clock::now() >= next_release) {
+      release_free_heap();
+      next_release = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
 }

@@ -5,6 +5,7 @@
 #include "soft_tissue_cutting/cutting/blade_path.hpp"
 #include "soft_tissue_cutting/io/vtk_writer.hpp"
 #include "soft_tissue_cutting/ros/conversions.hpp"
+#include "soft_tissue_cutting/ros/heap_release.hpp"
 #include "soft_tissue_cutting/ros/log_text.hpp"
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
@@ -110,6 +111,7 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   }
   answer_cuts(std::move(cancelled), "cancelled by ~reset");
   fresh.reset();  // the old state is freed outside the lock
+  release_free_heap();
   res.success = true;
   res.message = "reset to the initial state";
   return true;

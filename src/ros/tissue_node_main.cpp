@@ -1,7 +1,7 @@
 // tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). See tissue_node.hpp.
+#include "soft_tissue_cutting/ros/heap_release.hpp"
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
-#include <malloc.h>
 #include <ros/ros.h>
 
 #include <cstdlib>
@@ -9,13 +9,7 @@
 #include <string>
 
 int main(int argc, char** argv) {
-  // A fixed mmap threshold (glibc): blocks of 1 MB and more (the operation part's matrices,
-  // factors and recovery blocks, rebuilt at every cut and reset) get their own mappings and go
-  // back to the system when freed. With glibc's default the threshold rises to the size of the
-  // largest block freed so far (up to 32 MB), those blocks then come from the heap, and the
-  // node's RSS climbs with the heap's fragmentation: 240 -> 511 MB in a 6-minute soak of the
-  // organ-scale liver, 196 -> 256 MB with this setting (docs/ROS.md "Soak").
-  mallopt(M_MMAP_THRESHOLD, 1 << 20);
+  stc::ros_io::configure_heap();  // heap_release.hpp: RSS that follows what is in use
   ros::init(argc, argv, "tissue");
   ros::NodeHandle nh, pnh("~");
   stc::ros_io::NodeParams params;
