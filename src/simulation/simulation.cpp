@@ -198,6 +198,23 @@ struct Simulation::Impl {
     return map;
   }
 
+  // A ~cut path's deformation (PathCut::to_rest). A fixed region cuts part 1 only, so the map
+  // covers part 1. `follow`: the region moves to each sweep before it is cut
+  // (move_region_for_path_sweep), so the path may start or run where the ball is not yet: the
+  // map covers the whole tissue, every node's displacement recovered (S and Q from u_I, exact
+  // for the linear model), else a path beginning outside the ball would meet no tet of the map
+  // and cut nothing.
+  std::shared_ptr<DeformedToRest> path_to_rest() const {
+    if (!follower) return current_to_rest();
+    const Vector& u = model->displacement();
+    std::vector<Vec3> per_node(static_cast<size_t>(model->mesh().num_nodes()));
+    for (size_t i = 0; i < per_node.size(); ++i)
+      per_node[i] = u.segment<3>(3 * static_cast<long>(i));
+    auto map = std::make_shared<DeformedToRest>();
+    map->build(model->mesh(), per_node);  // every tet
+    return map;
+  }
+
   // frozen: carry the blade through this deformation (a ~cut path's, PathCut::to_rest)
   // instead of the current one.
   bool cut(const BladePose& from, const BladePose& to, StepStats& s,
@@ -651,7 +668,7 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     if (cut.done()) break;
     const BladePose& from = cut.poses[cut.next - 1];
     const BladePose& to = cut.poses[cut.next];
-    if (!cut.to_rest) cut.to_rest = impl_->current_to_rest();
+    if (!cut.to_rest) cut.to_rest = impl_->path_to_rest();
     // Does the blade edge lie in the (deformed) operation part here? (Tells "already cut" from
     // "missed".)
     if (!cut.crossed) {
