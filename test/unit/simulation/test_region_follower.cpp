@@ -404,6 +404,39 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   EXPECT_LT(o.error_vs_full, 1e-9);
 }
 
+// The same stroke with every pose held for three steps (a lockstep bag replay through
+// tissue_node does that): a blade held still sweeps nothing, so it must cost no region moves.
+// Before, a held step moved the ball back around the blade (no motion to look ahead by) and
+// the next sweep pushed it ahead again: 429 moves instead of 49, and online a backlog of
+// waiting sweeps the loop never caught up with.
+TEST(FollowRegion, BladeHeldStillMidStrokeCostsNoMoves) {
+  // config/scenes/thigh_follow.yaml: the thigh of TenCentimetreStrokeAcrossTheThigh.
+  Scene scene =
+      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/thigh_follow.yaml");
+  scene.solver.tolerance = 1e-12;
+  std::vector<BladePose> poses;
+  const double x_in = 0.048;
+  const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(0.065, 0.003, 0.02), 1, q);
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(x_in, 0.003, 0.02), 17, q);  // press
+  test::append_line(poses, Vec3(x_in, 0.003, 0.02), Vec3(x_in, 0.003, 0.12), 200, q);  // draw
+  test::append_line(poses, Vec3(x_in, 0.003, 0.12), Vec3(0.07, 0.003, 0.12), 20, q);   // lift
+  std::vector<BladePose> held;
+  for (const BladePose& p : poses) held.insert(held.end(), 3, p);
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation once(scene, offline), thrice(scene, offline);
+  const StrokeResult a = play_stroke(once, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, one step per pose", once, a);
+  const StrokeResult b = play_stroke(thrice, held, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, each pose held for three steps", thrice, b);
+  EXPECT_GE(a.moves, 3);
+  EXPECT_LE(b.moves, a.moves + a.moves / 4);
+  EXPECT_GE(b.opened, 0.9 * a.opened);
+  EXPECT_LE(b.max_gap, a.max_gap + 0.003);
+  EXPECT_LT(b.error_vs_full, 1e-9);
+}
+
 // A TetGen liver (sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`: 5.7k tets), a 3 cm
 // ball: a 10 cm stroke along x across its top (9.2 cm of it on the liver), 6 mm below the
 // surface, edge up, against `operation_region: all`. Cut pieces come free on the way and are held
