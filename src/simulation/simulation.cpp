@@ -198,6 +198,23 @@ struct Simulation::Impl {
     return map;
   }
 
+  // A ~cut path's deformation (PathCut::to_rest). A fixed region cuts part 1 only, so the map
+  // covers part 1. `follow`: the region moves to each sweep before it is cut
+  // (move_region_for_path_sweep), so the path may start or run where the ball is not yet: the
+  // map covers the whole tissue, every node's displacement recovered (S and Q from u_I, exact
+  // for the linear model), else a path beginning outside the ball would meet no tet of the map
+  // and cut nothing.
+  std::shared_ptr<DeformedToRest> path_to_rest() const {
+    if (!follower) return current_to_rest();
+    const Vector& u = model->displacement();
+    std::vector<Vec3> per_node(static_cast<size_t>(model->mesh().num_nodes()));
+    for (size_t i = 0; i < per_node.size(); ++i)
+      per_node[i] = u.segment<3>(3 * static_cast<long>(i));
+    auto map = std::make_shared<DeformedToRest>();
+    map->build(model->mesh(), per_node);  // every tet
+    return map;
+  }
+
   // frozen: carry the blade through this deformation (a ~cut path's, PathCut::to_rest)
   // instead of the current one.
   bool cut(const BladePose& from, const BladePose& to, StepStats& s,
@@ -460,10 +477,13 @@ struct Simulation::Impl {
     const BladeEdge edge = blade_edge(*blade, scene.scalpel.blade_length);
     std::string why = follower->edge_clearance(*model, cut_state, edge);
     if (why.empty()) return;
-    // Ahead along the blade's motion while it cuts; around it while it presses.
-    const Vec3 motion = blade_state == BladeState::kCutting && last_pose
-                            ? Vec3(blade->position - last_pose->position)
-                            : Vec3::Zero();
+    // Ahead along the blade's motion while it cuts (its last move: a blade held still for a
+    // step must not pull the ball back behind the cut's next sweep); around it while it
+    // presses.
+    Vec3 motion = Vec3::Zero();
+    if (blade_state == BladeState::kCutting)
+      for (auto p = stroke.rbegin(); p != stroke.rend() && motion.isZero(0); ++p)
+        motion = blade->position - p->position;
     const Vec3 centre =
         follower->centre_for(*model, cut_state, follower->edge_points(edge), motion);
     if (follower->worth_moving_to(centre)) start_move(centre, std::move(why));
@@ -539,11 +559,18 @@ struct Simulation::Impl {
         for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
         const bool retracing =
             last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
+        // A blade held still sweeps nothing. `follow`: such a sweep is not queued either: it
+        // has no motion to place the ball ahead by (centre_for), so between two moving sweeps
+        // it would pull the ball back and the next one push it ahead again, two moves per sweep
+        // (a lockstep bag replay holds every pose for a few steps: 429 moves instead of 49 on
+        // the 10 cm thigh stroke, and a backlog the online loop never caught up with).
+        const bool still = last_pose && last_pose->position == blade->position &&
+                           last_pose->orientation.coeffs() == blade->orientation.coeffs();
         if (last_pose && !retracing) {
-          if (follower)
-            pending_sweeps.push_back({*last_pose, *blade});
-          else
+          if (!follower)
             cut(*last_pose, *blade, s);
+          else if (!still)
+            pending_sweeps.push_back({*last_pose, *blade});
         }
         stroke.push_back(*blade);
         if (retracing || !edge_inside_tissue(edge)) {
@@ -651,7 +678,7 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     if (cut.done()) break;
     const BladePose& from = cut.poses[cut.next - 1];
     const BladePose& to = cut.poses[cut.next];
-    if (!cut.to_rest) cut.to_rest = impl_->current_to_rest();
+    if (!cut.to_rest) cut.to_rest = impl_->path_to_rest();
     // Does the blade edge lie in the (deformed) operation part here? (Tells "already cut" from
     // "missed".)
     if (!cut.crossed) {

@@ -9,8 +9,6 @@
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 #include <soft_tissue_cutting/SimStats.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Trigger.h>
@@ -47,13 +45,7 @@ struct Fixture : testing::Test {
   void SetUp() override {
     std::string path;
     ASSERT_TRUE(ros::param::get("~bag", path));
-    rosbag::Bag bag(path, rosbag::bagmode::Read);
-    for (const rosbag::MessageInstance& m :
-         rosbag::View(bag, rosbag::TopicQuery(std::vector<std::string>{"/scalpel/pose"}))) {
-      auto p = m.instantiate<geometry_msgs::PoseStamped>();
-      if (!p) continue;
-      poses.push_back(*p);
-    }
+    poses = tissue_test::read_scalpel_poses(path);
     ASSERT_GT(poses.size(), 50u) << "no scalpel poses in " << path;
 
     pose_pub = nh.advertise<geometry_msgs::PoseStamped>("/scalpel/pose", 100);
@@ -96,25 +88,10 @@ struct Fixture : testing::Test {
     spin_for(1.2);  // the post-reset hash arrives
     *initial_hash = hash;
     current = out;
-    // Lockstep: after each pose, wait until the node has stepped on it (three ~stats stamped
-    // after the publish: the third step surely started after the pose arrived). The node's
-    // loop samples the latest pose on its own clock, so a replay at the recorded pace would
-    // feed a different pose sequence each time; in lockstep every replay feeds the bag's
-    // exact sequence (some poses held for a few steps, which sweeps nothing).
-    for (size_t i = 0; i < poses.size(); ++i) {
-      const ros::Time sent = ros::Time::now();
-      pose_pub.publish(poses[i]);  // original (old) stamps: never a reason to drop
-      const size_t seen = out->stats.size();
-      ASSERT_TRUE(spin_until(
-          [&] {
-            int after = 0;
-            for (size_t k = seen; k < out->stats.size(); ++k)
-              after += out->stats[k].header.stamp > sent;
-            return after >= 3;
-          },
-          5.0))
+    // Lockstep (tissue_test::publish_in_lockstep): every replay feeds the bag's exact sequence.
+    for (size_t i = 0; i < poses.size(); ++i)
+      ASSERT_TRUE(tissue_test::publish_in_lockstep(pose_pub, poses[i], out->stats))
           << "the node stopped stepping";
-    }
     spin_for(1.5);
     current = nullptr;
     out->final_hash = hash;

@@ -1,14 +1,20 @@
 // Small helpers shared by the rostests (header-only: each rostest is one .cpp file).
 #pragma once
 
+#include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <soft_tissue_cutting/SimStats.h>
 #include <visualization_msgs/Marker.h>
 
 #include <array>
 #include <cstring>
 #include <functional>
 #include <map>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace tissue_test {
 
@@ -26,6 +32,37 @@ inline bool spin_until(const std::function<bool()>& pred, double timeout) {
 
 inline void spin_for(double seconds) {
   spin_until([] { return false; }, seconds);
+}
+
+// The /scalpel/pose messages of a bag (test/bags/, scripts/record_test_bag.sh), in order.
+inline std::vector<geometry_msgs::PoseStamped> read_scalpel_poses(const std::string& path) {
+  std::vector<geometry_msgs::PoseStamped> poses;
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m :
+       rosbag::View(bag, rosbag::TopicQuery(std::vector<std::string>{"/scalpel/pose"})))
+    if (auto p = m.instantiate<geometry_msgs::PoseStamped>()) poses.push_back(*p);
+  return poses;
+}
+
+// Lockstep replay: publishes `pose` and spins until the node has stepped on it, i.e. three
+// ~stats stamped after the publish arrived in `stats` (appended by the caller's subscription;
+// the third step surely started after the pose arrived). The node's loop samples the latest
+// pose on its own clock, so a replay at the recorded pace would feed a different pose sequence
+// each time; in lockstep every replay feeds the bag's exact sequence (some poses held for a
+// few steps, which sweeps nothing). False when the node stopped stepping.
+inline bool publish_in_lockstep(const ros::Publisher& pub, const geometry_msgs::PoseStamped& pose,
+                                const std::vector<soft_tissue_cutting::SimStats>& stats,
+                                double timeout = 5.0) {
+  const ros::Time sent = ros::Time::now();
+  pub.publish(pose);  // original (old) stamps: never a reason to drop
+  const size_t seen = stats.size();
+  return spin_until(
+      [&] {
+        int after = 0;
+        for (size_t k = seen; k < stats.size(); ++k) after += stats[k].header.stamp > sent;
+        return after >= 3;
+      },
+      timeout);
 }
 
 struct TriangleSoup {

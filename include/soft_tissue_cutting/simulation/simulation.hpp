@@ -84,12 +84,16 @@ struct PathCut {
   std::size_t next = 1;          // the next sweep is poses[next - 1] -> poses[next]
   int faces_before = 0;
   int tets_split = 0, nodes_added = 0;
-  bool changed = false;            // some sweep changed the mesh
-  bool crossed = false;            // some pose of the blade edge lay in the operation part
+  bool changed = false;  // some sweep changed the mesh
+  // Some pose of the blade edge lay in the operation part (`follow`: in the tissue, which the
+  // region moves to).
+  bool crossed = false;
   bool reached_interface = false;  // cut faces dropped at the interface of the condensed part
   // The deformation when the path was begun: every sweep of the path is carried to rest
   // coordinates through it, so the cut does not depend on how many steps (each a solve) run
-  // between slices - the path is where the tissue was when the cut was asked for.
+  // between slices - the path is where the tissue was when the cut was asked for. A fixed
+  // region's covers the operation part; a `follow` region's the whole tissue (the region moves
+  // along the path).
   std::shared_ptr<const DeformedToRest> to_rest;
   bool done() const { return !refusal.empty() || next >= poses.size(); }
 };

@@ -142,6 +142,67 @@ TEST(FollowRegion, RepartitionedModelSolvesTheSameWithCutGeometryCondensed) {
             1e-8 * reference.reaction_force(pressed).norm());
 }
 
+// A ~cut path that starts outside the follow ball (the ROS node's ~cut, whose caller knows
+// nothing of the region): the region moves to each sweep before it is cut, and the path is
+// carried to rest coordinates through the deformation of the whole tissue, not through the
+// part 1 the ball held when the path was begun (there the path meets no tet: before the fix
+// it cut nothing, "the blade path does not cross the operation part"). Opened faces along every
+// centimetre of the path.
+TEST(FollowRegion, CutPathStartingOutsideTheBallCutsEndToEnd) {
+  test::TempDir dir;
+  const Scene scene = load_scene(test::write_file(
+      dir.file("s.yaml"),
+      "mesh: {generator: {type: thigh, length: 0.14, resolution: 0.7}}\n"
+      "fixed: [{box: {min: [-0.0151, -0.0151, -0.001], max: [0.0151, 0.0151, 0.141]}}]\n"
+      "operation_region: {follow: {radius: 0.025}}\n"
+      "gravity: [0, -9.81, 0]\n"
+      "scalpel: {blade_length: 0.02, cut_pressure: 0.3}\n"
+      "trajectory: [{t: 0, position: [0.065, 0.003, 0.02]}]\n"
+      "solver: {tolerance: 1.0e-12}\n"));
+  Simulation sim(scene);  // online, as tissue_node runs it: cut_along waits for its moves
+  const Sphere ball = sim.region_moves()->ball;
+  // Edge radially out (+x), 12 mm deep, 3 cm along z; the ball (R 2.5 cm) is 5 cm away.
+  const double z0 = 0.07, z1 = 0.10;
+  std::vector<BladePose> path;
+  test::append_line(path, Vec3(0.048, 0.003, z0), Vec3(0.048, 0.003, z0), 1,
+                    Eigen::Quaterniond::Identity());
+  test::append_line(path, Vec3(0.048, 0.003, z0), Vec3(0.048, 0.003, z1), 30,
+                    Eigen::Quaterniond::Identity());
+  ASSERT_GT((path.front().position - ball.center).norm(), ball.radius + 0.02);
+  const CutOutcome cut = sim.cut_along(path);
+  // Opened cut faces per centimetre of the path (rest z), and how far they lie from the blade
+  // plane y = 0.003 in the deformed tissue, where the blade was: the tissue sags ~1 cm under
+  // gravity there, so the cut lies ~1 cm above the plane in rest coordinates.
+  std::vector<int> per_cm(3, 0);
+  double off_plane = 0;
+  const TetMesh& m = sim.mesh();
+  const DeformedSurface deformed = sim.surface();
+  for (const BoundaryTriangle& tri : extract_boundary_surface(m).triangles) {
+    if (!tri.cut) continue;
+    Vec3 c = Vec3::Zero(), x = Vec3::Zero();
+    for (int v : tri.nodes) c += m.nodes[v] / 3, x += deformed.positions[v] / 3;
+    const int bin = static_cast<int>(std::floor((c.z() - z0) / 0.01));
+    if (bin >= 0 && bin < 3) ++per_cm[bin];
+    off_plane = std::max(off_plane, std::abs(x.y() - 0.003));
+  }
+  const double error = test::relative_error_vs_full_model(sim);
+  std::printf(
+      "~cut path starting %.1f cm from the ball centre: %s; %d tets split, %d cut faces, %d "
+      "region moves (%d failed); opened faces per cm %d %d %d, at most %.2f mm off the blade "
+      "plane (deformed); vs full model %.2e\n",
+      100 * (path.front().position - ball.center).norm(), cut.message.c_str(), cut.tets_split,
+      cut.cut_faces, sim.region_moves()->moves, sim.region_moves()->failed, per_cm[0], per_cm[1],
+      per_cm[2], 1e3 * off_plane, error);
+  EXPECT_TRUE(cut.success) << cut.message;
+  EXPECT_GT(cut.cut_faces, 0);
+  EXPECT_GE(sim.region_moves()->moves, 1);
+  EXPECT_EQ(sim.region_moves()->failed, 0);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_GE(per_cm[k], 2) << "no opened faces in centimetre " << k << " of the path";
+  EXPECT_LT(off_plane, 0.003) << "the cut is not where the blade went through the tissue";
+  EXPECT_LT(error, 1e-9);
+}
+
 // A bar fixed at one end, the ball around its middle: a cut across the whole bar inside the ball
 // frees the far end, whose outer half is condensed. That end touches only this partition's
 // interface, which holds nothing once the region moves (and here the condensed half floats with
@@ -342,6 +403,39 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   EXPECT_GE(o.moves, 3);
   EXPECT_GE(o.opened, 0.9 * b.opened);
   EXPECT_LT(o.error_vs_full, 1e-9);
+}
+
+// The same stroke with every pose held for three steps (a lockstep bag replay through
+// tissue_node does that): a blade held still sweeps nothing, so it must cost no region moves.
+// Before, a held step moved the ball back around the blade (no motion to look ahead by) and
+// the next sweep pushed it ahead again: 429 moves instead of 49, and online a backlog of
+// waiting sweeps the loop never caught up with.
+TEST(FollowRegion, BladeHeldStillMidStrokeCostsNoMoves) {
+  // config/scenes/thigh_follow.yaml: the thigh of TenCentimetreStrokeAcrossTheThigh.
+  Scene scene =
+      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/thigh_follow.yaml");
+  scene.solver.tolerance = 1e-12;
+  std::vector<BladePose> poses;
+  const double x_in = 0.048;
+  const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(0.065, 0.003, 0.02), 1, q);
+  test::append_line(poses, Vec3(0.065, 0.003, 0.02), Vec3(x_in, 0.003, 0.02), 17, q);  // press
+  test::append_line(poses, Vec3(x_in, 0.003, 0.02), Vec3(x_in, 0.003, 0.12), 200, q);  // draw
+  test::append_line(poses, Vec3(x_in, 0.003, 0.12), Vec3(0.07, 0.003, 0.12), 20, q);   // lift
+  std::vector<BladePose> held;
+  for (const BladePose& p : poses) held.insert(held.end(), 3, p);
+  SimulationOptions offline;
+  offline.wait_for_region_moves = true;
+  Simulation once(scene, offline), thrice(scene, offline);
+  const StrokeResult a = play_stroke(once, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, one step per pose", once, a);
+  const StrokeResult b = play_stroke(thrice, held, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, each pose held for three steps", thrice, b);
+  EXPECT_GE(a.moves, 3);
+  EXPECT_LE(b.moves, a.moves + a.moves / 4);
+  EXPECT_GE(b.opened, 0.9 * a.opened);
+  EXPECT_LE(b.max_gap, a.max_gap + 0.003);
+  EXPECT_LT(b.error_vs_full, 1e-9);
 }
 
 // The TetGen liver of the follow tests: sofa_liver2.obj scaled to ~11 x 6 x 7 cm, TetGen `pQ`
