@@ -317,16 +317,28 @@ struct Simulation::Impl {
     // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
     // (its condensation is nonsingular), and those are anchored.
     const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
-    for (const MeshPiece& piece : free_pieces(part1, anchored)) {
+    const std::vector<MeshPiece> pieces = free_pieces(part1, anchored);
+    for (const MeshPiece& piece : pieces) {
       for (int n : piece.nodes) {
         held[n] = model->operation_displacement().segment<3>(3 * n);
         anchored[static_cast<size_t>(n)] = 1;
       }
       ++free_pieces_held;
-      if (options.log)
-        options.log(LogLevel::kInfo, "a piece of " + std::to_string(piece.tets.size()) +
-                                         " tets was cut free; it is held in place");
     }
+    log_pieces_held(pieces);
+  }
+
+  // One line per cut, however many pieces it frees (a cut through slivers frees dozens).
+  void log_pieces_held(const std::vector<MeshPiece>& pieces) const {
+    if (pieces.empty() || !options.log) return;
+    size_t tets = 0;
+    for (const MeshPiece& piece : pieces) tets += piece.tets.size();
+    options.log(
+        LogLevel::kInfo,
+        pieces.size() == 1
+            ? "a piece of " + std::to_string(tets) + " tets was cut free; it is held in place"
+            : std::to_string(pieces.size()) + " pieces (" + std::to_string(tets) +
+                  " tets in all) were cut free; they are held in place");
   }
 
   // `follow`: a piece may reach into the condensed part (cut there before a move), so pieces
@@ -335,7 +347,8 @@ struct Simulation::Impl {
   // part 1, where its nodes are held too (adopt_moved_region).
   void hold_free_pieces_anywhere() {
     const Partition& p = model->partition();
-    for (const MeshPiece& piece : free_pieces(model->mesh(), anchored)) {
+    const std::vector<MeshPiece> pieces = free_pieces(model->mesh(), anchored);
+    for (const MeshPiece& piece : pieces) {
       for (int n : piece.nodes) {
         const NodeSet set = p.node_set[static_cast<size_t>(n)];
         if (set == NodeSet::kOperation || set == NodeSet::kInterface)
@@ -344,10 +357,8 @@ struct Simulation::Impl {
         held_piece_nodes.push_back(n);
       }
       ++free_pieces_held;
-      if (options.log)
-        options.log(LogLevel::kInfo, "a piece of " + std::to_string(piece.tets.size()) +
-                                         " tets was cut free; it is held in place");
     }
+    log_pieces_held(pieces);
   }
 
   // ---- `follow`: the operation region moves with the blade (region_follower.hpp)

@@ -4,6 +4,7 @@
 // TetGen liver, crossing several region moves, cuts continuously, keeps docs/SCENE.md "Cut
 // invariants" after every step and equals the full model at the end.
 #include "common/follow_stroke.hpp"
+#include "common/free_piece_log.hpp"
 
 #include "collision/tissue_samples.hpp"
 #include "cutting/free_pieces.hpp"
@@ -570,7 +571,7 @@ TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   offline.wait_for_region_moves = true;
   int logged_pieces = 0, found_at_moves = 0;
   offline.log = [&](LogLevel, const std::string& m) {
-    logged_pieces += m.find("cut free") != std::string::npos;
+    logged_pieces += test::pieces_reported(m);
     found_at_moves += m.find("found free at a region move") != std::string::npos;
   };
   Simulation sim(scene, offline);
