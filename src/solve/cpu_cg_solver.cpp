@@ -169,6 +169,7 @@ class CpuCgSolver final : public LinearSolver {
         result.message = iteration_cap_message(result, settings);
         return result;
       }
+      const Vector pass_start = x;  // kept if this pass only makes things worse
       Vector z = precondition(r);
       Vector p = z;
       double rz = r.dot(z);
@@ -193,16 +194,26 @@ class CpuCgSolver final : public LinearSolver {
       const double true_res = r_true.norm() / rhs_norm;
       if (true_res <= settings.tolerance || result.iterations >= settings.max_iterations ||
           !(true_res < result.residual)) {
-        result.residual = true_res;
-        result.converged = true_res <= settings.tolerance;
+        // Never hand back an iterate worse than the one this pass began from (on a system
+        // that is not positive definite CG can end far off: a relative residual of 116 was
+        // published as the tissue's shape for a minute in a soak). A NaN counts as worse.
+        const bool reverted = !(true_res <= result.residual);
+        if (reverted)
+          x = pass_start;
+        else
+          result.residual = true_res;
+        result.converged = result.residual <= settings.tolerance;
         if (!result.converged)
           result.message = result.iterations >= settings.max_iterations
                                ? iteration_cap_message(result, settings)
                                : "CG stopped gaining at relative residual " +
-                                     format_residual(true_res) + " (tolerance " +
+                                     format_residual(result.residual) + " (tolerance " +
                                      format_residual(settings.tolerance) +
                                      "): too ill-conditioned for double precision, or not "
                                      "positive definite on the free DOFs";
+        if (reverted)
+          result.message += "; the last iterate was worse (" + format_residual(true_res) +
+                            "), the one before this pass is kept";
         return result;
       }
     }

@@ -51,5 +51,27 @@ TEST(FemCgSolver, ProjectedConstrainedDofs) {
   EXPECT_LE((x - xd).norm(), 1e-10 * xd.norm());
 }
 
+// A system that is not positive definite (eigenvalues 3 and -1; the diagonal is 1, so Jacobi
+// is the identity): from x = 0 the first CG step lands on (1, 0), whose residual is twice the
+// start's, and the next direction has p'Ap < 0. The solver must report the failure and hand
+// back the better of the two (the start), never the worse one.
+TEST(FemCgSolver, NeverReturnsAnIterateWorseThanItsStart) {
+  SparseMatrix a(2, 2);
+  a.insert(0, 0) = 1;
+  a.insert(0, 1) = 2;
+  a.insert(1, 0) = 2;
+  a.insert(1, 1) = 1;
+  a.makeCompressed();
+  const Vector b = Vector::Unit(2, 0);
+  auto cg = make_cpu_solver(CgPreconditioner::kJacobi);
+  cg->set_matrix(a);
+  Vector x = Vector::Zero(2);
+  const CgResult r = cg->solve(b, x, {}, CgSettings{1e-10, 100});
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(x, Vector::Zero(2)) << "the worse iterate " << x.transpose() << " was returned";
+  EXPECT_DOUBLE_EQ(r.residual, 1.0);  // the start's, not the last iterate's 2
+  EXPECT_NE(r.message.find("the one before this pass is kept"), std::string::npos) << r.message;
+}
+
 }  // namespace
 }  // namespace stc
