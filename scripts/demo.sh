@@ -25,17 +25,13 @@ if ! command -v roslaunch >/dev/null || [ -z "${ROS_PACKAGE_PATH:-}" ]; then
   source "$("$ROOT/tissue" where)"
   set -u
 fi
+# shellcheck source=scene_path.sh
+source "$ROOT/scripts/scene_path.sh"
 scene="${1:-thigh}"
-if [ "$scene" != thigh ]; then
-  if [ -f "$scene" ]; then
-    scene="$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")"
-  elif [ -f "$ROOT/config/scenes/$scene.yaml" ]; then
-    scene="$ROOT/config/scenes/$scene.yaml"
-  else
-    echo "demo: unknown scene '$scene': use thigh, a scene YAML, or one of:" \
-      "$(cd "$ROOT/config/scenes" && ls -- *.yaml | sed 's/\.yaml$//' | tr '\n' ' ')" >&2
-    exit 1
-  fi
+if ! scene="$(scene_path "$scene" "$ROOT")"; then
+  echo "demo: unknown scene '${1}': use thigh, a scene YAML, or one of:" \
+    "$(cd "$ROOT/config/scenes" && ls -- *.yaml | sed 's/\.yaml$//' | tr '\n' ' ')" >&2
+  exit 1
 fi
 if [ "$scene" != thigh ] && ! grep -qE '^trajectory:' "$scene"; then
   echo "demo: note: $(basename "$scene") has no 'trajectory': the node runs without a scalpel"

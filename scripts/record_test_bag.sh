@@ -20,16 +20,14 @@ while [ $# -gt 0 ]; do
     *) echo "record_test_bag: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
+# shellcheck source=scene_path.sh
+source "$ROOT/scripts/scene_path.sh"
+if ! scene="$(scene_path "$scene" "$ROOT")"; then
+  echo "record_test_bag: unknown scene '$scene': use thigh, a scene YAML or a name in" \
+    "config/scenes/" >&2
+  exit 2
+fi
 if [ "$scene" != thigh ]; then
-  if [ -f "$scene" ]; then
-    scene="$(cd "$(dirname "$scene")" && pwd)/$(basename "$scene")"
-  elif [ -f "$ROOT/config/scenes/$scene.yaml" ]; then
-    scene="$ROOT/config/scenes/$scene.yaml"
-  else
-    echo "record_test_bag: unknown scene '$scene': use thigh, a scene YAML or a name in" \
-      "config/scenes/" >&2
-    exit 2
-  fi
   grep -qE '^trajectory:' "$scene" || { echo "record_test_bag: $scene has no trajectory" >&2; exit 2; }
 fi
 export PATH="/usr/bin:/bin:$PATH" ROS_IP=127.0.0.1 ROS_HOME="$ROOT/out/record_bag"

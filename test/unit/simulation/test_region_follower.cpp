@@ -143,6 +143,16 @@ TEST(FollowRegion, RepartitionedModelSolvesTheSameWithCutGeometryCondensed) {
             1e-8 * reference.reaction_force(pressed).norm());
 }
 
+// The refined thigh (resolution 0.7) of the follow-region stroke tests, a 2.5 cm follow ball.
+const char* const kThighFollowYaml =
+    "mesh: {generator: {type: thigh, length: 0.14, resolution: 0.7}}\n"
+    "fixed: [{box: {min: [-0.0151, -0.0151, -0.001], max: [0.0151, 0.0151, 0.141]}}]\n"
+    "operation_region: {follow: {radius: 0.025}}\n"
+    "gravity: [0, -9.81, 0]\n"
+    "scalpel: {blade_length: 0.02, cut_pressure: 0.3}\n"
+    "trajectory: [{t: 0, position: [0.065, 0.003, 0.02]}]\n"
+    "solver: {tolerance: 1.0e-12}\n";
+
 // A ~cut path that starts outside the follow ball (the ROS node's ~cut, whose caller knows
 // nothing of the region): the region moves to each sweep before it is cut, and the path is
 // carried to rest coordinates through the deformation of the whole tissue, not through the
@@ -151,15 +161,7 @@ TEST(FollowRegion, RepartitionedModelSolvesTheSameWithCutGeometryCondensed) {
 // centimetre of the path.
 TEST(FollowRegion, CutPathStartingOutsideTheBallCutsEndToEnd) {
   test::TempDir dir;
-  const Scene scene = load_scene(test::write_file(
-      dir.file("s.yaml"),
-      "mesh: {generator: {type: thigh, length: 0.14, resolution: 0.7}}\n"
-      "fixed: [{box: {min: [-0.0151, -0.0151, -0.001], max: [0.0151, 0.0151, 0.141]}}]\n"
-      "operation_region: {follow: {radius: 0.025}}\n"
-      "gravity: [0, -9.81, 0]\n"
-      "scalpel: {blade_length: 0.02, cut_pressure: 0.3}\n"
-      "trajectory: [{t: 0, position: [0.065, 0.003, 0.02]}]\n"
-      "solver: {tolerance: 1.0e-12}\n"));
+  const Scene scene = load_scene(test::write_file(dir.file("s.yaml"), kThighFollowYaml));
   Simulation sim(scene);  // online, as tissue_node runs it: cut_along waits for its moves
   const Sphere ball = sim.region_moves()->ball;
   // Edge radially out (+x), 12 mm deep, 3 cm along z; the ball (R 2.5 cm) is 5 cm away.
@@ -358,15 +360,7 @@ void report(const char* name, const Simulation& sim, const StrokeResult& r) {
 // the moves must cost no cut area and leave no gap that the cutter alone does not leave.
 TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   test::TempDir dir;
-  const std::string path = test::write_file(
-      dir.file("s.yaml"),
-      "mesh: {generator: {type: thigh, length: 0.14, resolution: 0.7}}\n"
-      "fixed: [{box: {min: [-0.0151, -0.0151, -0.001], max: [0.0151, 0.0151, 0.141]}}]\n"
-      "operation_region: {follow: {radius: 0.025}}\n"
-      "gravity: [0, -9.81, 0]\n"
-      "scalpel: {blade_length: 0.02, cut_pressure: 0.3}\n"
-      "trajectory: [{t: 0, position: [0.065, 0.003, 0.02]}]\n"
-      "solver: {tolerance: 1.0e-12}\n");
+  const std::string path = test::write_file(dir.file("s.yaml"), kThighFollowYaml);
   const Scene scene = load_scene(path);
   const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // edge radially out (+x)
   std::vector<BladePose> poses;
