@@ -9,6 +9,17 @@
 namespace stc {
 namespace {
 
+// One flag per mesh node: 1 for the held ones (HybridModel::set_held_nodes).
+std::vector<std::uint8_t> held_flags(const TetMesh& mesh, const std::vector<int>& nodes) {
+  std::vector<std::uint8_t> held(static_cast<size_t>(mesh.num_nodes()), 0);
+  for (int n : nodes) {
+    if (n < 0 || n >= mesh.num_nodes())
+      throw std::invalid_argument("HybridModel: held node " + std::to_string(n) + " out of range");
+    held[static_cast<size_t>(n)] = 1;
+  }
+  return held;
+}
+
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -88,18 +99,13 @@ HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> oper
       gravity_(from.gravity_),
       point_loads_(from.point_loads_),
       fixed_(from.fixed_),
-      held_(from.mesh_.nodes.size(), 0),
+      held_(held_flags(from.mesh_, held_nodes)),
       elements_(from.elements_),  // at the current E: the new condensation is at scale 1
       solver_(std::move(solver)),
       settings_(from.settings_) {
   if (!solver_) throw std::invalid_argument("HybridModel: no linear solver");
   if (operation_tet.size() != static_cast<size_t>(mesh_.num_tets()))
     throw std::invalid_argument("HybridModel: one operation label per tet expected");
-  for (int n : held_nodes) {
-    if (n < 0 || n >= mesh_.num_nodes())
-      throw std::invalid_argument("HybridModel: held node out of range");
-    held_[static_cast<size_t>(n)] = 1;
-  }
   const auto start = Clock::now();
   const auto t0 = Clock::now();
   partition_ = partition_from_labels(mesh_, std::move(operation_tet));
@@ -324,12 +330,7 @@ std::vector<std::uint8_t> HybridModel::held_dofs() const {
 }
 
 void HybridModel::set_held_nodes(const std::vector<int>& nodes) {
-  std::vector<std::uint8_t> held(static_cast<size_t>(mesh_.num_nodes()), 0);
-  for (int n : nodes) {
-    if (n < 0 || n >= mesh_.num_nodes())
-      throw std::invalid_argument("HybridModel::set_held_nodes: node out of range");
-    held[static_cast<size_t>(n)] = 1;
-  }
+  std::vector<std::uint8_t> held = held_flags(mesh_, nodes);
   if (held == held_) return;
   held_ = std::move(held);
   solver_->set_matrix(a_, held_dofs());

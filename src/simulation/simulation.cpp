@@ -42,6 +42,13 @@ double median_operation_edge(const TetMesh& mesh, const std::vector<std::uint8_t
   return edges[edges.size() / 2];
 }
 
+// One Vec3 per node from a global DOF vector (3 per node), as the rest mapping takes them.
+std::vector<Vec3> per_node(const Vector& u) {
+  std::vector<Vec3> out(static_cast<size_t>(u.size() / 3));
+  for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
+  return out;
+}
+
 }  // namespace
 
 struct Simulation::Impl {
@@ -206,12 +213,8 @@ struct Simulation::Impl {
   // and cut nothing.
   std::shared_ptr<DeformedToRest> path_to_rest() const {
     if (!follower) return current_to_rest();
-    const Vector& u = model->displacement();
-    std::vector<Vec3> per_node(static_cast<size_t>(model->mesh().num_nodes()));
-    for (size_t i = 0; i < per_node.size(); ++i)
-      per_node[i] = u.segment<3>(3 * static_cast<long>(i));
     auto map = std::make_shared<DeformedToRest>();
-    map->build(model->mesh(), per_node);  // every tet
+    map->build(model->mesh(), per_node(model->displacement()));  // every tet
     return map;
   }
 
@@ -279,28 +282,10 @@ struct Simulation::Impl {
     for (const NewNode& n : r.new_nodes)
       if (n.kind == NewNode::Kind::kDuplicate)
         if (const auto it = held.find(n.a); it != held.end()) held[n.index] = it->second;
-    // Anchored = what really holds a node: fixed, on the interface, or held. Recomputed, not
-    // inherited by copies: a copy of an interface node is not attached to the condensed part,
-    // and a node marked anchored without an imposed displacement would count towards the
-    // three anchors of a piece that in fact floats (a singular system; CG stalls).
-    // `follow`: fixed or held only, never interface (see start()): a piece whose only support
-    // is this partition's interface floats once the region moves.
-    anchored = model->fixed_nodes();
-    if (!follower)
-      for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
-    for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
-    // A held piece's condensed nodes follow its held ones (`follow` only; else empty).
-    for (int n : held_piece_nodes) anchored[static_cast<size_t>(n)] = 1;
+    recompute_anchors();
     hold_free_pieces();
-    // The held nodes leave the solver's factor (a piece held by a hinge would make it
-    // singular; cpu_cg_solver.cpp).
-    std::vector<int> held_nodes;
-    held_nodes.reserve(held.size());
-    for (const auto& [n, u] : held) held_nodes.push_back(n);
-    model->set_held_nodes(held_nodes);
-    const Partition& p = model->partition();
-    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
-                       p.operation_tet, displacements());
+    pass_held_nodes_to_model();
+    rebuild_surface_tree();
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
@@ -308,6 +293,36 @@ struct Simulation::Impl {
     tets_split += r.tets_split;
     ++cuts;
     return true;
+  }
+
+  // Anchored = what really holds a node: fixed, on the interface, or held. Recomputed, not
+  // inherited by copies: a copy of an interface node is not attached to the condensed part,
+  // and a node marked anchored without an imposed displacement would count towards the three
+  // anchors of a piece that in fact floats (a singular system; CG stalls). `follow`: fixed or
+  // held only, never interface: a piece whose only support is this partition's interface
+  // floats once the region moves; a held piece's condensed nodes follow its held ones.
+  void recompute_anchors() {
+    anchored = model->fixed_nodes();
+    if (!follower)
+      for (int i : model->partition().interface) anchored[static_cast<size_t>(i)] = 1;
+    for (const auto& [n, u] : held) anchored[static_cast<size_t>(n)] = 1;
+    for (int n : held_piece_nodes) anchored[static_cast<size_t>(n)] = 1;
+  }
+
+  // The held nodes leave the solver's factor (a piece held by a hinge would make it singular;
+  // cpu_cg_solver.cpp).
+  void pass_held_nodes_to_model() {
+    std::vector<int> nodes;
+    nodes.reserve(held.size());
+    for (const auto& [n, u] : held) nodes.push_back(n);
+    model->set_held_nodes(nodes);
+  }
+
+  // The operation surface of the current mesh and partition, at the current displacement.
+  void rebuild_surface_tree() {
+    const Partition& p = model->partition();
+    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
+                       p.operation_tet, displacements());
   }
 
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
@@ -437,16 +452,9 @@ struct Simulation::Impl {
     const Vector& u = model->operation_displacement();
     for (int n : held_piece_nodes)
       if (!held.count(n) && operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
-    std::vector<int> held_nodes;
-    held_nodes.reserve(held.size());
-    for (const auto& [n, h] : held) held_nodes.push_back(n);
-    model->set_held_nodes(held_nodes);  // the worker's set: no refactorization
-    anchored = model->fixed_nodes();
-    for (int n : held_nodes) anchored[static_cast<size_t>(n)] = 1;
-    for (int n : held_piece_nodes) anchored[static_cast<size_t>(n)] = 1;
-    const Partition& p = model->partition();
-    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
-                       p.operation_tet, displacements());
+    pass_held_nodes_to_model();  // the worker's set: no refactorization
+    recompute_anchors();
+    rebuild_surface_tree();
     s.region_moved = true;
   }
 
@@ -526,12 +534,7 @@ struct Simulation::Impl {
 
   // O and I current, S as last recovered: the tree's operation triangles (the only ones
   // contact looks at) are exact, and a step does not wait for the recovery of u_S.
-  std::vector<Vec3> displacements() const {
-    const Vector& u = model->operation_displacement();
-    std::vector<Vec3> out(static_cast<size_t>(model->mesh().num_nodes()));
-    for (size_t i = 0; i < out.size(); ++i) out[i] = u.segment<3>(3 * static_cast<long>(i));
-    return out;
-  }
+  std::vector<Vec3> displacements() const { return per_node(model->operation_displacement()); }
 
   int cut_face_count() const {
     int n = 0;
