@@ -41,9 +41,7 @@ std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh) {
   return pieces;
 }
 
-std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored) {
-  // Pieces by shared FACES: a piece that hangs on the rest by a node or an edge only (a
-  // hinge: it can rotate about it) has a singular stiffness, so it counts as its own piece.
+std::vector<MeshPiece> face_connected_pieces(const TetMesh& mesh) {
   std::vector<int> parent(mesh.tets.size());
   std::iota(parent.begin(), parent.end(), 0);
   std::unordered_map<std::uint64_t, int> first_tet;
@@ -75,12 +73,20 @@ std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::u
     }
     pieces[piece_of_root[root]].tets.push_back(t);
   }
-  std::vector<MeshPiece> free;
   for (MeshPiece& piece : pieces) {
     for (int t : piece.tets)
       for (int v : mesh.tets[t]) piece.nodes.push_back(v);
     std::sort(piece.nodes.begin(), piece.nodes.end());
     piece.nodes.erase(std::unique(piece.nodes.begin(), piece.nodes.end()), piece.nodes.end());
+  }
+  return pieces;
+}
+
+std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored) {
+  // Pieces by shared FACES: a piece that hangs on the rest by a node or an edge only (a
+  // hinge: it can rotate about it) has a singular stiffness, so it counts as its own piece.
+  std::vector<MeshPiece> free;
+  for (MeshPiece& piece : face_connected_pieces(mesh)) {
     // Held in place only by three anchored nodes that are not on one line (one or two
     // would leave it free to rotate).
     std::vector<Vec3> held;
@@ -99,6 +105,15 @@ std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::u
     if (!rigid) free.push_back(std::move(piece));
   }
   return free;
+}
+
+const MeshPiece* smallest_piece_with_node(const std::vector<MeshPiece>& pieces, int node) {
+  const MeshPiece* best = nullptr;
+  for (const MeshPiece& piece : pieces)
+    if (std::binary_search(piece.nodes.begin(), piece.nodes.end(), node) &&
+        (!best || piece.tets.size() < best->tets.size()))
+      best = &piece;
+  return best;
 }
 
 }  // namespace stc

@@ -22,6 +22,13 @@ struct MeshPiece {
 // or edge implies a shared node), in order of their smallest tet.
 std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh);
 
+// Components connected by shared FACES, in order of their smallest tet.
+std::vector<MeshPiece> face_connected_pieces(const TetMesh& mesh);
+
+// The smallest of `pieces` that has `node` (a node shared by several through a hinge belongs
+// to each); nullptr if none has it.
+const MeshPiece* smallest_piece_with_node(const std::vector<MeshPiece>& pieces, int node);
+
 // The pieces not held rigidly: components connected by shared FACES (a piece hanging on by a
 // node or an edge can rotate about it) with fewer than three non-collinear anchored nodes
 // (anchored: per node, e.g. fixed or interface nodes).

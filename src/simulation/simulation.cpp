@@ -285,6 +285,7 @@ struct Simulation::Impl {
     recompute_anchors();
     hold_free_pieces();
     pass_held_nodes_to_model();
+    hold_what_the_factor_finds_singular();
     rebuild_surface_tree();
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;
@@ -341,6 +342,53 @@ struct Simulation::Impl {
       ++free_pieces_held;
     }
     log_pieces_held(pieces);
+  }
+
+  // docs/SCENE.md "Cut invariants": the system stays positive definite on its free DOFs. The
+  // anchor rule above decides by topology; should the factor of the system still meet a pivot
+  // that is not positive, the smallest face-connected piece through the DOF where it failed
+  // is held as well (a piece the rule took for anchored), and the log says what it was, so a
+  // case the rule misses costs a warning, not a solver that stops converging (a 30-minute
+  // soak once lost a minute that way). Never the bulk of the operation part: that is an error
+  // no hold can repair, logged as such.
+  void hold_what_the_factor_finds_singular() {
+    constexpr int kMaxRepairs = 4;
+    for (int repair = 0; repair < kMaxRepairs; ++repair) {
+      const int dof = model->solver().singular_dof();
+      if (dof < 0) return;
+      const int node = model->hybrid_dofs().global_of[static_cast<size_t>(dof)] / 3;
+      const TetMesh searched =
+          follower ? model->mesh() : tet_subset(model->mesh(), model->partition().operation_tets);
+      const std::vector<MeshPiece> pieces = face_connected_pieces(searched);
+      const MeshPiece* piece = smallest_piece_with_node(pieces, node);
+      int anchors = 0;
+      if (piece)
+        for (int n : piece->nodes) anchors += anchored[static_cast<size_t>(n)] != 0;
+      const std::string what =
+          "after a cut the system was not positive definite at node " + std::to_string(node);
+      if (!piece || 2 * piece->tets.size() > searched.tets.size()) {
+        if (options.log)
+          options.log(LogLevel::kError,
+                      what + ", which no small piece holds (" +
+                          (piece ? std::to_string(piece->tets.size()) + " tets, " +
+                                       std::to_string(anchors) + " anchored nodes"
+                                 : std::string("in no operation tet")) +
+                          "); the solve will not converge until ~reset");
+        return;
+      }
+      const Vector& u = model->operation_displacement();
+      for (int n : piece->nodes) {  // as hold_free_pieces(_anywhere) holds a piece
+        if (!follower || operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
+        anchored[static_cast<size_t>(n)] = 1;
+        if (follower) held_piece_nodes.push_back(n);
+      }
+      ++free_pieces_held;
+      if (options.log)
+        options.log(LogLevel::kWarn, what + ": the piece of " + std::to_string(piece->tets.size()) +
+                                         " tets around it (" + std::to_string(anchors) +
+                                         " anchored nodes) is held in place");
+      pass_held_nodes_to_model();
+    }
   }
 
   // One line per cut, however many pieces it frees (a cut through slivers frees dozens).

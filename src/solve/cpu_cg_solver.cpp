@@ -44,6 +44,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -68,6 +69,16 @@ class CpuCgSolver final : public LinearSolver {
   std::string backend() const override { return "cpu"; }
   std::string preconditioner() const override { return active_; }
   double setup_ms() const override { return setup_ms_; }
+  // Found on demand (one more factorization), so a cut whose first factor fails only until
+  // its free pieces are held pays nothing for it.
+  int singular_dof() const override {
+    if (!factor_failed_) return -1;
+    if (!singular_dof_) {
+      const int c = SparseCholesky::first_failing_column(factored_block());
+      singular_dof_ = c < 0 || kept_.empty() ? c : kept_[static_cast<size_t>(c)];
+    }
+    return *singular_dof_;
+  }
 
   void set_matrix(const SparseMatrix& a) override { set_matrix(a, {}); }
 
@@ -92,6 +103,8 @@ class CpuCgSolver final : public LinearSolver {
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
     chol_.reset();
     held_.reset();
+    factor_failed_ = false;
+    singular_dof_.reset();
     active_ = "jacobi";
     if (wanted_ == CgPreconditioner::kCholesky) factor();
     setup_ms_ =
@@ -252,6 +265,7 @@ class CpuCgSolver final : public LinearSolver {
       active_ = "cholesky";
       return;
     } catch (const std::runtime_error&) {
+      factor_failed_ = true;
     }
     SparseMatrix shifted = block;
     const double dmax = block.diagonal().cwiseAbs().maxCoeff();
@@ -276,6 +290,8 @@ class CpuCgSolver final : public LinearSolver {
   std::vector<int> kept_;  // DOFs in the factor when some are held (empty: all)
   Vector held_mask_;       // per DOF: 1 = held (named in set_matrix)
   std::string active_ = "jacobi";
+  bool factor_failed_ = false;               // A (or A_kk) has no Cholesky factor
+  mutable std::optional<int> singular_dof_;  // where, once asked (singular_dof())
   double setup_ms_ = 0;
 };
 

@@ -10,8 +10,25 @@ namespace stc {
 // Eigen's wrapper drives CHOLMOD directly: cholmod_analyze + cholmod_factorize with
 // supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), and cholmod_solve on a whole
 // dense block of right-hand sides at once.
+namespace {
+
+using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// Eigen's wrapper with CHOLMOD's factor in view: where a failed factorization stopped
+// (L->minor, in the permuted order L->Perm; exact for a simplicial factor, while a supernodal
+// one reports its supernode's first column).
+class SimplicialWithFactor : public Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> {
+ public:
+  int failed_column() const {
+    const cholmod_factor* l = m_cholmodFactor;
+    if (!l || l->minor >= l->n) return -1;
+    return l->Perm ? static_cast<const int*>(l->Perm)[l->minor] : static_cast<int>(l->minor);
+  }
+};
+
+}  // namespace
+
 struct SparseCholesky::Impl {
-  using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
   Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower> supernodal;
   Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> simplicial;
   CholeskyMethod method = CholeskyMethod::kSupernodal;
@@ -39,7 +56,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
   // A is symmetric, so its row-major arrays are also its column-major arrays: copied as they
   // are instead of transposed (CHOLMOD reads the lower triangle: A's upper one, equal to
   // rounding).
-  Impl::ColMatrix col(a.rows(), a.cols());
+  ColMatrix col(a.rows(), a.cols());
   if (a.isCompressed()) {
     col.resizeNonZeros(a.nonZeros());
     std::copy(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1, col.outerIndexPtr());
@@ -64,6 +81,16 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
     throw std::runtime_error(
         "sparse Cholesky (CHOLMOD): matrix not positive definite - a part of the mesh is "
         "neither fixed nor held by the interface");
+}
+
+int SparseCholesky::first_failing_column(const SparseMatrix& a) {
+  if (a.rows() == 0) return -1;
+  SimplicialWithFactor probe;
+  probe.cholmod().print = 0;
+  probe.cholmod().nmethods = 1;
+  probe.cholmod().method[0].ordering = CHOLMOD_AMD;
+  probe.compute(ColMatrix(a));
+  return probe.info() == Eigen::Success ? -1 : probe.failed_column();
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {

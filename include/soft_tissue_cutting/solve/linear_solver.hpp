@@ -50,6 +50,10 @@ class LinearSolver {
   // The preconditioner in use for the current matrix ("jacobi", "cholesky", ...); it may
   // differ from the one asked for when set_matrix had to fall back. Empty if not reported.
   virtual std::string preconditioner() const { return ""; }
+  // A DOF (row of A) at which the factorization of the current matrix (without the held DOFs)
+  // found it not positive definite: a mode of the system that nothing holds involves it. -1:
+  // it factored, or this solver does not factor (Jacobi, gl).
+  virtual int singular_dof() const { return -1; }
   // Wall time of the last set_matrix in ms (factorization, for the Cholesky preconditioner).
   virtual double setup_ms() const { return 0; }
   // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.

@@ -38,6 +38,11 @@ class SparseCholesky {
                           CholeskyMethod method = CholeskyMethod::kSupernodal,
                           CholeskyOrdering ordering = CholeskyOrdering::kDefault);
 
+  // Where a factorization of `a` meets a pivot that is not positive: the row/column of `a` at
+  // which a simplicial LL^T (AMD order) stops, so a mode of `a` that nothing holds involves it;
+  // -1 if `a` is positive definite. A diagnosis for failures (it factors `a` once more).
+  static int first_failing_column(const SparseMatrix& a);
+
   // X = A^-1 B for all columns of B in one CHOLMOD call.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   Vector solve(const Vector& b) const;

@@ -4,12 +4,17 @@
 #include "cutting/cut_state.hpp"
 #include "cutting/cut_sweep.hpp"
 #include "cutting/free_pieces.hpp"
+#include "soft_tissue_cutting/assembly/element_cache.hpp"
+#include "soft_tissue_cutting/assembly/global_assembly.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/solve/linear_solver.hpp"
+#include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numeric>
 
 namespace stc {
 using test::closed_cut_faces;
@@ -149,6 +154,53 @@ TEST(CutCases, SeveredPieceIsFoundAsFree) {
   for (int t : free[0].tets) volume += tet_volume(cube.mesh, t);
   EXPECT_NEAR(volume, 0.015 * kSide * kSide, 1e-12);
   for (int v : free[0].nodes) EXPECT_GE(cube.mesh.nodes[v].x(), 0.025 - 1e-12);
+}
+
+// The fallback behind the anchor rule (simulation.cpp, hold_what_the_factor_finds_singular):
+// when a severed piece is NOT held, the factor of the stiffness on the free DOFs fails at a
+// DOF of that piece, and the smallest face-connected piece through its node is the piece the
+// anchor rule would have held. Held, the same system factors.
+TEST(CutCases, TheFactorPointsAtAPieceNothingHolds) {
+  Cube cube;
+  cube.sweep({0.025, -0.01}, {0.025, 0.05});
+  const TetMesh& mesh = cube.mesh;
+  std::vector<std::uint8_t> anchored(mesh.nodes.size(), 0);
+  for (int v = 0; v < mesh.num_nodes(); ++v) anchored[v] = mesh.nodes[v].x() == 0.0;
+  const auto free = free_pieces(mesh, anchored);
+  ASSERT_EQ(free.size(), 1u);
+  // Free DOFs: every DOF of a node that is not fixed (x = 0).
+  DofMap dofs;
+  dofs.row_of.assign(3 * mesh.nodes.size(), -1);
+  for (int v = 0; v < mesh.num_nodes(); ++v)
+    if (!anchored[v])
+      for (int c = 0; c < 3; ++c) {
+        dofs.row_of[3 * v + c] = dofs.rows();
+        dofs.global_of.push_back(3 * v + c);
+      }
+  std::vector<int> all(mesh.tets.size());
+  std::iota(all.begin(), all.end(), 0);
+  const SparseMatrix k =
+      assemble_stiffness(mesh, ElementStiffnessCache(mesh, Material{}), all, dofs);
+  const int column = SparseCholesky::first_failing_column(k);
+  ASSERT_GE(column, 0);
+  EXPECT_TRUE(std::binary_search(free[0].nodes.begin(), free[0].nodes.end(),
+                                 dofs.global_of[static_cast<size_t>(column)] / 3))
+      << "the factor failed at a node outside the severed piece";
+  auto solver = make_cpu_solver(CgPreconditioner::kCholesky);
+  solver->set_matrix(k);
+  const int dof = solver->singular_dof();
+  ASSERT_GE(dof, 0) << "a severed piece nothing holds must not factor";
+  const int node = dofs.global_of[static_cast<size_t>(dof)] / 3;
+  const MeshPiece* piece = smallest_piece_with_node(face_connected_pieces(mesh), node);
+  ASSERT_NE(piece, nullptr);
+  EXPECT_EQ(piece->tets, free[0].tets) << "node " << node << " at " << mesh.nodes[node].transpose();
+  // The piece held (its DOFs left out of the factor): it factors, and says so.
+  std::vector<std::uint8_t> held(static_cast<size_t>(k.rows()), 0);
+  for (int v : free[0].nodes)
+    for (int c = 0; c < 3; ++c) held[static_cast<size_t>(dofs.row_of[3 * v + c])] = 1;
+  solver->set_matrix(k, held);
+  EXPECT_EQ(solver->singular_dof(), -1);
+  EXPECT_EQ(solver->preconditioner(), "cholesky");
 }
 
 TEST(CutCases, LockedNodeIsNeverDuplicatedAndTheBladeStops) {

@@ -272,3 +272,125 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6AndAnSpdSystem) {
 
 }  // namespace
 }  // namespace stc
+
+namespace stc {
+namespace {
+
+// What `./tissue soak` does to the node (scripts/soak_driver.py), in lockstep and seeded, so a
+// failure it finds can be replayed: a random-walk scalpel around the operation region (steps of
+// r/100, pulled back within 1.3 r, a random-walk orientation), every 500 steps a burst of 20
+// service actions (cutting enabled, or a straight ~cut path of 2, 10 or 200 poses with the
+// identity orientation, inserted between the walk's steps as the node
+// slices it: one to three sweeps before a step), a reset every 6,000 steps. While a cut step
+// runs the node's walk goes on in real time: after a step that cut, the blade advances 30 walk
+// increments at once. After every step:
+// a converged, finite solve; after every cut, an SPD free block. Scene and length:
+// TISSUE_SOAK_REPLICA_SCENE (a scene file; default the built-in thigh) and
+// TISSUE_SOAK_REPLICA_STEPS (default 3,000), seed TISSUE_SOAK_REPLICA_SEED (default 12).
+TEST(SimulationRandomCuts, SoakReplicaKeepsAConvergedSpdSystem) {
+  const char* scene_env = std::getenv("TISSUE_SOAK_REPLICA_SCENE");
+  const char* steps_env = std::getenv("TISSUE_SOAK_REPLICA_STEPS");
+  const Scene scene = scene_env ? load_scene(scene_env) : make_thigh_scene();
+  const long steps = steps_env ? std::atol(steps_env) : 3000;
+  ASSERT_GT(steps, 0) << "TISSUE_SOAK_REPLICA_STEPS must be a positive number";
+  ASSERT_EQ(scene.operation_region.kind, OperationRegion::Kind::kSphere);
+  // The anchor rule must hold every piece itself: a piece the factor had to find (a WARN or an
+  // ERROR from the simulation) is a miss, reported with the step.
+  std::vector<std::string> misses;
+  long k = 0;
+  SimulationOptions options;
+  options.log = [&misses, &k](LogLevel level, const std::string& message) {
+    if (level != LogLevel::kInfo) misses.push_back("step " + std::to_string(k) + ": " + message);
+  };
+  Simulation sim(scene, options);
+  const Vec3 c = scene.operation_region.sphere.center;
+  const double r = scene.operation_region.sphere.radius;
+  const char* seed_env = std::getenv("TISSUE_SOAK_REPLICA_SEED");
+  std::mt19937 rng(seed_env ? static_cast<unsigned>(std::atol(seed_env)) : 12u);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Vec3 p = c;
+  Eigen::Vector4d q(0, 0, 0, 1);
+  const auto walk = [&] {
+    p += std::max(r / 100, 1e-4) * Vec3(gauss(rng), gauss(rng), gauss(rng));
+    if ((p - c).norm() > 1.3 * r) p = c + (p - c) * 1.3 * r / (p - c).norm();
+    for (int k = 0; k < 4; ++k) q[k] += 0.01 * gauss(rng);
+    q.normalize();
+  };
+  std::vector<std::vector<BladePose>> queued;
+  std::optional<PathCut> active;
+  int cut_steps = 0, path_cuts = 0, resets = 0;
+  for (k = 0; k < steps; ++k) {
+    if (k > 0 && k % 6000 == 0) {
+      sim.reset();
+      queued.clear();
+      active.reset();
+      ++resets;
+    }
+    if (k % 500 == 250)
+      for (int action = 0; action < 20; ++action) {
+        if (rng() % 2 == 0) {
+          sim.set_cutting_enabled(true);
+          continue;
+        }
+        const Vec3 a = c + r * Vec3(unit(rng), unit(rng), unit(rng));
+        const Vec3 b = a + r * Vec3(unit(rng), unit(rng), unit(rng));
+        const int n = std::array<int, 3>{2, 10, 200}[rng() % 3];
+        std::vector<BladePose> path(static_cast<size_t>(n));
+        for (int s = 0; s < n; ++s)
+          path[static_cast<size_t>(s)].position = a + s * (b - a) / (n - 1);
+        queued.push_back(std::move(path));
+      }
+    bool path_cut = false;
+    if (!active && !queued.empty()) {
+      active = sim.begin_path_cut(queued.front());
+      queued.erase(queued.begin());
+    }
+    // The node's slice lasts up to 40 % of a period: one to three sweeps before a step.
+    for (int sweeps = 1 + static_cast<int>(rng() % 3); sweeps > 0 && active && !active->done();
+         --sweeps) {
+      sim.cut_path_slice(*active, std::chrono::steady_clock::time_point{});
+      path_cut = true;
+    }
+    walk();
+    BladePose blade;
+    blade.position = p;
+    blade.orientation = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
+    blade.t = static_cast<double>(k) / 100;
+    const StepStats s = sim.step(blade);
+    if (active && active->done()) {
+      sim.finish_path_cut(*active);
+      active.reset();
+      ++path_cuts;
+    }
+    cut_steps += s.cutting;
+    if (s.cutting || path_cut)
+      for (int i = 0; i < 30; ++i) walk();
+    if (s.cutting || path_cut) {
+      InvariantLimits limits;
+      limits.initial_volume = sim.counts().volume_initial;
+      const auto violated = check_cut_invariants(sim.mesh(), sim.tet_size_classes(), limits);
+      ASSERT_TRUE(violated.empty()) << "step " << k << ": " << violated.front();
+    }
+    // The SPD check (a sparse Cholesky of the free block, free pieces found again) costs more
+    // than an organ-scale step: after every cut on small scenes, on failure on the others.
+    if (!s.converged || ((s.cutting || path_cut) && sim.counts().tets < 20000)) {
+      ASSERT_NO_THROW(SparseCholesky{free_block(sim)}) << "step " << k << ": not SPD";
+    }
+    ASSERT_TRUE(s.converged) << "step " << k << " (" << cut_steps << " cut steps, " << path_cuts
+                             << " paths, " << resets << " resets): " << solve_diagnosis(sim);
+    ASSERT_TRUE(sim.model().displacement().allFinite()) << "step " << k;
+    ASSERT_TRUE(misses.empty()) << misses.front();
+    if ((k + 1) % 1000 == 0) {
+      std::printf("soak replica: %ld steps, %d cut steps, %d paths, %d tets, %d free pieces\n",
+                  k + 1, cut_steps, path_cuts, sim.counts().tets, sim.counts().free_pieces_held);
+      std::fflush(stdout);
+    }
+  }
+  std::printf("soak replica: %ld steps, %d cut steps, %d paths, %d resets\n", steps, cut_steps,
+              path_cuts, resets);
+  EXPECT_GT(cut_steps + path_cuts, 0);
+}
+
+}  // namespace
+}  // namespace stc
