@@ -130,6 +130,7 @@ void HybridModel::condense_and_assemble(Clock::time_point start) {
   u_ = Vector::Zero(3 * mesh_.num_nodes());
   const auto t0 = Clock::now();
   rebuild_hybrid_system();
+  refresh_factor();  // at precompute (a moved region's model: on the worker), not at a step
   timings_["hybrid_assembly"] = ms_since(t0);
   timings_["total"] = ms_since(start);
 }
@@ -174,8 +175,16 @@ void HybridModel::rebuild_hybrid_system() {
   b_ = gather(f, dofs_);
   for (int k = 0; k < idofs.rows(); ++k)
     b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
-  solver_->set_matrix(a_, held_dofs());
+  // Factored at first use (refresh_factor): a cut that frees pieces, or a ~cut slice of
+  // several sweeps, changes the matrix or the held set more than once before the next solve.
+  factor_stale_ = true;
   system_changed_ = true;
+}
+
+void HybridModel::refresh_factor() const {
+  if (!factor_stale_) return;
+  solver_->set_matrix(a_, held_dofs());
+  factor_stale_ = false;
 }
 
 CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
@@ -204,6 +213,7 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
     }
   }
   if (dofs_.rows() > 0) {
+    refresh_factor();
     last_ = solver_->solve(b_, x, constrained, settings_);
   } else {
     last_ = CgResult{};  // `none`: nothing to solve, u_S = c_S
@@ -333,14 +343,15 @@ void HybridModel::set_held_nodes(const std::vector<int>& nodes) {
   std::vector<std::uint8_t> held = held_flags(mesh_, nodes);
   if (held == held_) return;
   held_ = std::move(held);
-  solver_->set_matrix(a_, held_dofs());
+  factor_stale_ = true;
   system_changed_ = true;
 }
 
 void HybridModel::set_solver(std::unique_ptr<LinearSolver> solver) {
   if (!solver) throw std::invalid_argument("HybridModel: no linear solver");
   solver_ = std::move(solver);
-  solver_->set_matrix(a_, held_dofs());
+  factor_stale_ = true;
+  refresh_factor();
   system_changed_ = true;
 }
 

@@ -75,6 +75,7 @@ struct Simulation::Impl {
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
+  bool cut_since_solve = false;  // the next solve first checks the factor (a missed piece)
 
   enum class BladeState { kFree, kPressing, kCutting } blade_state = BladeState::kFree;
   EdgeContact contact;  // the nodes the blade holds while pressing (tip and edge)
@@ -146,6 +147,7 @@ struct Simulation::Impl {
     }
     held.clear();
     free_pieces_held = 0;
+    cut_since_solve = false;
     blade_state = BladeState::kFree;
     contact.release();
     last_pose.reset();
@@ -180,9 +182,13 @@ struct Simulation::Impl {
   }
 
   bool solve(const ImposedDisplacements& contact, StepStats& s) {
+    const auto t0 = Clock::now();
+    // The model factors at first use, once for all the sweeps and held pieces since the last
+    // solve; a piece the anchor rule missed is held before the solve needs the factor.
+    if (cut_since_solve) hold_what_the_factor_finds_singular();
+    cut_since_solve = false;
     ImposedDisplacements imposed = held;
     imposed.insert(contact.begin(), contact.end());  // held pieces win over contact
-    const auto t0 = Clock::now();
     const CgResult r = model->solve(imposed);
     s.solve_ms += ms_since(t0);
     s.cg_iterations += r.iterations;
@@ -285,7 +291,7 @@ struct Simulation::Impl {
     recompute_anchors();
     hold_free_pieces();
     pass_held_nodes_to_model();
-    hold_what_the_factor_finds_singular();
+    cut_since_solve = true;
     rebuild_surface_tree();
     s.assembly_ms += ms_since(t0);
     s.tets_split += r.tets_split;

@@ -97,11 +97,16 @@ class HybridModel {
 
   // Nodes held in place in every solve until changed (free pieces, simulation.cpp): the solver
   // builds its preconditioner without their DOFs (LinearSolver::set_matrix). A copy made of a
-  // held node by a cut is held too. Refactors only when the set changes.
+  // held node by a cut is held too. The solver is set up again (at first use) only when the set
+  // changes.
   void set_held_nodes(const std::vector<int>& nodes);
 
   void set_solver(std::unique_ptr<LinearSolver> solver);
-  const LinearSolver& solver() const { return *solver_; }
+  // The solver, set up (factored) for the current matrix and held nodes.
+  const LinearSolver& solver() const {
+    refresh_factor();
+    return *solver_;
+  }
   // New settings: the next solve runs even if nothing else changed (a tighter tolerance).
   void set_cg_settings(const CgSettings& settings) {
     settings_ = settings;
@@ -154,6 +159,9 @@ class HybridModel {
   mutable bool condensed_stale_ = true;  // u_I moved since then
   mutable long recoveries_ = 0;
   bool system_changed_ = true;  // matrix, rhs or u_ changed since the last solve
+  // The solver has not seen the current matrix or held set yet (set up at first use).
+  mutable bool factor_stale_ = false;
+  void refresh_factor() const;
   ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;
   CgSettings settings_;
