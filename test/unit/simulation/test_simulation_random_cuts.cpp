@@ -207,6 +207,7 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
         done, cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before,
         mesh_quality(sim.mesh()).min_dihedral_deg, sorted[sorted.size() / 2], sorted.back(),
         cold_iterations, not_converged, worst_residual);
+    std::fflush(stdout);
   };
   for (int k = 0; k < strokes; ++k) {
     BladePose a, b;
@@ -228,7 +229,7 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
     not_converged += !sim.model().last_result().converged;
     worst_residual = std::max(worst_residual, sim.model().last_result().residual);
     ASSERT_TRUE(sim.model().displacement().allFinite()) << "stroke " << k;
-    if (k + 1 == 100 || k + 1 == strokes) report(k + 1);
+    if (k + 1 == 100 || (k + 1) % 1000 == 0 || k + 1 == strokes) report(k + 1);
   }
   EXPECT_GT(cuts, strokes * 3 / 10);
   // Not asserted (README, known limitations): after some strokes CG stops converging (16 of
