@@ -86,6 +86,9 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   // The trajectory; the first pressing step's constraint is kept for the full model.
   const std::vector<BladePose> poses = substepped(scene.trajectory, step_m);
   std::vector<double> pressing, cutting, refresh, pressing_cpu, cutting_cpu;
+  // Where a cutting step's time goes (StepStats stages, docs/DESIGN.md section 10).
+  std::vector<double> cut_collision, cut_insertion, cut_model_update, cut_solve;
+  std::vector<double> press_collision, press_solve;
   bool recorded = false;
   for (const BladePose& p : poses) {
     c0 = cpu_ms_now();
@@ -101,9 +104,17 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
       refresh.push_back(ms_since(tr));
       if (drawn.positions.empty()) throw std::runtime_error("empty surface");
     }
-    if (step_kind(s) == StepKind::kCutting) cutting.push_back(s.step_ms);
+    if (step_kind(s) == StepKind::kCutting) {
+      cutting.push_back(s.step_ms);
+      cut_collision.push_back(s.collision_ms);
+      cut_insertion.push_back(s.cutting_ms);
+      cut_model_update.push_back(s.assembly_ms);
+      cut_solve.push_back(s.solve_ms);
+    }
     if (step_kind(s) == StepKind::kPressing) {
       pressing.push_back(s.step_ms);
+      press_collision.push_back(s.collision_ms);
+      press_solve.push_back(s.solve_ms);
       if (!recorded && sim.counts().cuts == 0) {
         // The three mesh nodes nearest the tip (deformed) with their displacements: the
         // same kind and size of constraint as the blade's contact triangle.
@@ -136,6 +147,12 @@ nlohmann::json time_hybrid(const BenchCase& c, double step_m, int idle_steps) {
   j["pressing"] = summary(pressing);
   j["cutting"] = summary(cutting);
   j["surface_refresh_ms"] = summary(refresh);
+  j["cut_step_stages_ms_median"] = {{"collision", summarize_step_times(cut_collision).median},
+                                    {"cut_insertion", summarize_step_times(cut_insertion).median},
+                                    {"model_update", summarize_step_times(cut_model_update).median},
+                                    {"solve_with_factor", summarize_step_times(cut_solve).median}};
+  j["step_stages_ms_median"] = {{"collision", summarize_step_times(press_collision).median},
+                                {"solve", summarize_step_times(press_solve).median}};
   cpu["idle_step_median"] = summarize_step_times(idle_cpu).median;
   cpu["step_median"] = summarize_step_times(pressing_cpu).median;
   cpu["cut_step_median"] = summarize_step_times(cutting_cpu).median;
