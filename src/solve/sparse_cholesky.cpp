@@ -7,19 +7,48 @@
 
 namespace stc {
 
-// Eigen's wrapper drives CHOLMOD directly: cholmod_analyze + cholmod_factorize with
-// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), and cholmod_solve on a whole
-// dense block of right-hand sides at once.
+// Eigen's wrapper drives CHOLMOD's factorization: cholmod_analyze + cholmod_factorize with
+// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T). Solves call cholmod_solve on
+// the factor directly, each with its own cholmod_common: Eigen's solve() goes through the one
+// cholmod_common it keeps (workspace counters, status), so two threads solving with one
+// factor would race on it. The factor itself is only read by cholmod_solve, so a const
+// SparseCholesky may be shared by threads (the condensed part's factor: the loop and the ROS
+// display thread, recovery/).
+template <typename Llt>
+struct FactorOf : Llt {
+  cholmod_factor* factor() const { return this->m_cholmodFactor; }
+};
+
 struct SparseCholesky::Impl {
   using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-  Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower> supernodal;
-  Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> simplicial;
+  FactorOf<Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower>> supernodal;
+  FactorOf<Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower>> simplicial;
   CholeskyMethod method = CholeskyMethod::kSupernodal;
 
-  template <typename Rhs>
-  Rhs solve(const Rhs& b) const {
-    if (method == CholeskyMethod::kSimplicial) return simplicial.solve(b);
-    return supernodal.solve(b);
+  // X = A^-1 B, B column-major with rows() rows. Thread-safe (see above).
+  Eigen::MatrixXd solve(const double* b, int rows, int cols) const {
+    cholmod_factor* factor =
+        method == CholeskyMethod::kSimplicial ? simplicial.factor() : supernodal.factor();
+    cholmod_common common;
+    cholmod_start(&common);
+    common.print = 0;
+    cholmod_dense rhs{};
+    rhs.nrow = rhs.d = static_cast<size_t>(rows);
+    rhs.ncol = static_cast<size_t>(cols);
+    rhs.nzmax = rhs.nrow * rhs.ncol;
+    rhs.x = const_cast<double*>(b);  // read only: cholmod_solve writes a new matrix
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor, &rhs, &common);
+    if (!x) {
+      cholmod_finish(&common);
+      throw std::runtime_error("sparse Cholesky (CHOLMOD): the solve failed (out of memory?)");
+    }
+    Eigen::MatrixXd out =
+        Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), rows, cols);
+    cholmod_free_dense(&x, &common);
+    cholmod_finish(&common);
+    return out;
   }
 };
 
@@ -68,14 +97,14 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (rows_ == 0 || b.cols() == 0) return Eigen::MatrixXd::Zero(rows_, b.cols());
-  Eigen::MatrixXd x = impl_->solve(b);
-  return x;
+  if (b.rows() != rows_) throw std::invalid_argument("SparseCholesky::solve: size mismatch");
+  return impl_->solve(b.data(), rows_, static_cast<int>(b.cols()));
 }
 
 Vector SparseCholesky::solve(const Vector& b) const {
   if (rows_ == 0) return Vector::Zero(0);
-  Vector x = impl_->solve(b);
-  return x;
+  if (b.size() != rows_) throw std::invalid_argument("SparseCholesky::solve: size mismatch");
+  return impl_->solve(b.data(), rows_, 1);
 }
 
 void solve_direct(const SparseMatrix& a, const Vector& b, Vector& x,

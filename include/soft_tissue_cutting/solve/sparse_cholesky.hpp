@@ -38,7 +38,9 @@ class SparseCholesky {
                           CholeskyMethod method = CholeskyMethod::kSupernodal,
                           CholeskyOrdering ordering = CholeskyOrdering::kDefault);
 
-  // X = A^-1 B for all columns of B in one CHOLMOD call.
+  // X = A^-1 B for all columns of B in one CHOLMOD call. Thread-safe: the factor is never
+  // changed after construction and each call has its own CHOLMOD workspace, so threads may
+  // share one factor (the condensed part's, recovered on the ROS display thread).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   Vector solve(const Vector& b) const;
   int rows() const { return rows_; }
