@@ -9,4 +9,12 @@ Vector recover_condensed(const CondensedPart& condensed, const Vector& u_interfa
   return condensed.factor_NN ? condensed.factor_NN->solve(rhs) : Vector(Vector::Zero(0));
 }
 
+void DisplacementSnapshot::recover() {
+  if (!stale) return;
+  if (condensed && condensed->condensed_dofs.rows() > 0)
+    scatter(recover_condensed(*condensed, gather(u, condensed->interface_dofs), stiffness_scale),
+            condensed->condensed_dofs, u);
+  stale = false;
+}
+
 }  // namespace stc

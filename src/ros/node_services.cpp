@@ -93,6 +93,7 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
     return true;
   }
   std::deque<std::shared_ptr<CutJob>> cancelled;
+  std::optional<DisplayFrame> frame;
   {
     std::lock_guard<std::mutex> lock(sim_mutex_);
     fresh->set_cutting_enabled(sim_->cutting_enabled());  // ~set_cutting survives a reset
@@ -107,8 +108,9 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
       queued_cuts_.clear();
     }
     remember_backend_locked();
-    publish_surface_locked(ros::Time::now());
+    frame = display_frame_locked(true);  // the fresh state, drawn outside the lock
   }
+  publish_frame(std::move(*frame));
   answer_cuts(std::move(cancelled), "cancelled by ~reset");
   fresh.reset();  // the old state is freed outside the lock
   release_free_heap();

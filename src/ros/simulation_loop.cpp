@@ -1,6 +1,7 @@
 // The simulation loop: one step per period at ~rate, every step measured (LoopMonitor), and
 // the ~cut path in progress inserted in bounded slices between steps, so a long cut never
-// stops the loop or its publishing.
+// stops the loop or its publishing. The surface is drawn by the display thread
+// (node_display.cpp), never here.
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
 
 namespace stc {
@@ -41,7 +42,6 @@ void TissueNode::loop() {
       finish_cut_locked(s);
       const ros::Time stamp = ros::Time::now();
       publish_step_locked(s, blade, stamp, monitor_.health(Clock::now()).rate_hz);
-      publish_display_locked(s, stamp);
       ++steps_;
     }
     monitor_.step_finished(Clock::now(), converged);

@@ -87,12 +87,10 @@ PoseGateSettings TissueNode::pose_gate_settings() const {
 
 void TissueNode::start() {
   started_ = std::chrono::steady_clock::now();
-  {
-    std::lock_guard<std::mutex> lock(sim_mutex_);
-    publish_surface_locked(ros::Time::now());
-  }
+  publish_display_now();
   running_ = true;
   thread_ = std::thread(&TissueNode::loop, this);
+  display_thread_ = std::thread(&TissueNode::display_thread, this);
   diagnostics_thread_ = std::thread(&TissueNode::diagnostics_thread, this);
   const ModelCounts c = sim_->counts();
   ROS_INFO("tissue_node: scene '%s', %d nodes, %d tets, backend %s, %.0f steps/s in '%s'",
@@ -104,6 +102,7 @@ void TissueNode::start() {
 void TissueNode::stop() {
   running_ = false;
   if (thread_.joinable()) thread_.join();
+  if (display_thread_.joinable()) display_thread_.join();
   if (diagnostics_thread_.joinable()) diagnostics_thread_.join();
   std::deque<std::shared_ptr<CutJob>> left;
   {

@@ -117,18 +117,27 @@ HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> oper
 void HybridModel::condense_and_assemble(Clock::time_point start) {
   // K0, g0 (docs/DESIGN.md eqs. (8)-(9)). Loads on interface nodes stay with part 1 (they enter f_I
   // below), so only f_N reaches the condensation.
-  condensed_ = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
+  CondensedPart part = condense_non_operation_part(mesh_, elements_, partition_, loads(), fixed_);
+  // K0 enters every hybrid matrix as one sparse block (k0_padded_, which set_young_modulus
+  // rescales), so the dense K0 leaves the part. The rest of the part never changes: it is
+  // shared with displacement snapshots, recovered on other threads, perhaps after this model
+  // is gone.
+  Eigen::MatrixXd k0 = std::move(part.K0);
+  part.K0 = Eigen::MatrixXd();
+  condensed_ = std::make_shared<const CondensedPart>(std::move(part));
   // Part 2's gravity never changes: kept, so a cut re-lumps the operation tets only.
   condensed_gravity_ = Vector::Zero(3 * mesh_.num_nodes());
   add_gravity_of(mesh_, partition_.condensed_tets, elements_.material().density, gravity_,
                  condensed_gravity_);
-  timings_["condensation_assembly"] = condensed_.assembly_ms;
-  timings_["condensation_factor"] = condensed_.factor_ms;
-  timings_["condensation_solve"] = condensed_.solve_ms;
-  timings_["condensation_products"] = condensed_.product_ms;
+  timings_["condensation_assembly"] = condensed_->assembly_ms;
+  timings_["condensation_factor"] = condensed_->factor_ms;
+  timings_["condensation_solve"] = condensed_->solve_ms;
+  timings_["condensation_products"] = condensed_->product_ms;
 
   u_ = Vector::Zero(3 * mesh_.num_nodes());
   const auto t0 = Clock::now();
+  k0_padded_ = k0.sparseView(0.0, 0.0);
+  k0 = Eigen::MatrixXd();
   rebuild_hybrid_system();
   refresh_factor();  // at precompute (a moved region's model: on the worker), not at a step
   timings_["hybrid_assembly"] = ms_since(t0);
@@ -146,20 +155,19 @@ void HybridModel::rebuild_hybrid_system() {
   std::vector<int> nodes = partition_.interface;
   nodes.insert(nodes.end(), partition_.operation.begin(), partition_.operation.end());
   dofs_ = make_dof_map(mesh_.num_nodes(), nodes, fixed_);
-  const DofMap& idofs = condensed_.interface_dofs;
+  const DofMap& idofs = condensed_->interface_dofs;
   interface_row_.resize(static_cast<size_t>(idofs.rows()));
   for (int k = 0; k < idofs.rows(); ++k)
     interface_row_[static_cast<size_t>(k)] = dofs_.row_of[static_cast<size_t>(idofs.global_of[k])];
 
   // K1 from part-1 tets, plus K0 on the interface block (eq. 17). The free interface DOFs are
   // the first rows, in the condensation's order (I is listed first and never changes), so
-  // K0 enters as one sparse matrix kept from the first assembly: a cut re-assembles part 1
+  // K0 enters as one sparse matrix kept from the condensation: a cut re-assembles part 1
   // only and adds K0 (a merge), never re-sorting the dense block's |3I|^2 triplets.
   for (int k = 0; k < idofs.rows(); ++k)
     if (interface_row_[static_cast<size_t>(k)] != k)
       throw std::logic_error("HybridModel: the interface DOFs are not the leading rows");
-  const int ni = idofs.rows(), n = dofs_.rows();
-  if (k0_padded_.rows() != ni) k0_padded_ = condensed_.K0.sparseView(0.0, 0.0);
+  const int n = dofs_.rows();
   std::vector<Triplet> t;
   t.reserve(partition_.operation_tets.size() * 144);
   add_element_triplets(mesh_, elements_, partition_.operation_tets, dofs_.row_of, dofs_.row_of, t);
@@ -174,7 +182,7 @@ void HybridModel::rebuild_hybrid_system() {
   add_gravity_of(mesh_, partition_.operation_tets, elements_.material().density, gravity_, f);
   b_ = gather(f, dofs_);
   for (int k = 0; k < idofs.rows(); ++k)
-    b_[interface_row_[static_cast<size_t>(k)]] -= condensed_.g0[k];
+    b_[interface_row_[static_cast<size_t>(k)]] -= condensed_->g0[k];
   // Factored at first use (refresh_factor): a cut that frees pieces, or a ~cut slice of
   // several sweeps, changes the matrix or the held set more than once before the next solve.
   factor_stale_ = true;
@@ -221,7 +229,7 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
   }
   scatter(x, dofs_, u_);
   // u_S and u_Q follow u_I alone: recovered on demand (displacement()), and only if u_I moved.
-  Vector u_i = gather(u_, condensed_.interface_dofs);
+  Vector u_i = gather(u_, condensed_->interface_dofs);
   if (u_i != recovered_from_) condensed_stale_ = true;
   last_imposed_ = imposed;
   system_changed_ = false;
@@ -231,14 +239,32 @@ CgResult HybridModel::solve(const ImposedDisplacements& imposed) {
 const Vector& HybridModel::displacement() const {
   if (!condensed_stale_) return u_;
   // u_N = K2_NN^-1 (f_N - K2_NI u_I) (docs/DESIGN.md eq. (13)) through the kept factor: S and Q at
-  // once, exact to the factorization's rounding, no dense 3|S| x 3|I| operator in memory.
-  recovered_from_ = gather(u_, condensed_.interface_dofs);
-  if (condensed_.condensed_dofs.rows() > 0)
-    scatter(recover_condensed(condensed_, recovered_from_, condensed_scale_),
-            condensed_.condensed_dofs, u_);
-  condensed_stale_ = false;
+  // once, exact to the factorization's rounding, no dense 3|S| x 3|I| operator in memory. The
+  // same path as a snapshot recovered on another thread.
+  DisplacementSnapshot s = displacement_snapshot();
+  s.recover();
   ++recoveries_;
+  adopt_recovery(s);
   return u_;
+}
+
+DisplacementSnapshot HybridModel::displacement_snapshot() const {
+  DisplacementSnapshot s;
+  s.u = u_;
+  s.condensed = condensed_;
+  s.stiffness_scale = condensed_scale_;
+  s.stale = condensed_stale_;
+  return s;
+}
+
+void HybridModel::adopt_recovery(const DisplacementSnapshot& s) const {
+  // Only a recovery through this model's factor at its present stiffness; its u_I may be
+  // older than the current one (then S and Q stay stale, as recovered from that u_I).
+  if (s.stale || s.condensed != condensed_ || s.stiffness_scale != condensed_scale_) return;
+  const DofMap& n = condensed_->condensed_dofs;
+  if (n.rows() > 0) scatter(gather(s.u, n), n, u_);
+  recovered_from_ = gather(s.u, condensed_->interface_dofs);
+  condensed_stale_ = gather(u_, condensed_->interface_dofs) != recovered_from_;
 }
 
 void HybridModel::recover_interior() { displacement(); }
@@ -321,8 +347,7 @@ void HybridModel::set_young_modulus(double young_modulus) {
   if (!(young_modulus > 0)) throw std::invalid_argument("young_modulus must be > 0");
   const double s = young_modulus / elements_.material().young_modulus;
   elements_.set_young_modulus(young_modulus);
-  condensed_.K0 *= s;  // K2 scales with E
-  k0_padded_ *= s;
+  k0_padded_ *= s;        // K0: K2 scales with E
   condensed_scale_ *= s;  // u_N recovery: K2_NN^-1 f_N scales with 1/E; g0 is a ratio
   condensed_stale_ = true;
   rebuild_hybrid_system();

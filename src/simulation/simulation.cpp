@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <deque>
 #include <stdexcept>
 
@@ -87,7 +86,7 @@ struct Simulation::Impl {
   std::vector<Vec3> last_rest_edge;
 
   bool cutting_enabled = true;
-  std::uint64_t steps = 0, surface_version = 0;
+  std::uint64_t steps = 0, surface_version = 0, mesh_version = 0;
   int cuts = 0, tets_split = 0;
   long cg_iterations_total = 0;
   long solver_fallbacks = 0;
@@ -165,6 +164,7 @@ struct Simulation::Impl {
     boundary.init(model->mesh(), model->partition().operation_tet);
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
+    ++mesh_version;
   }
 
   // A piece of the input with no fixed node would float: refuse it up front with its size,
@@ -283,6 +283,7 @@ struct Simulation::Impl {
     s.reached_interface |= r.reached_interface;
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
     t0 = Clock::now();
+    ++mesh_version;
     model->update_operation_part(r.changed_tets, r.new_nodes);
     // A copy of a held node stays held (both halves of a cut held piece stay put).
     for (const NewNode& n : r.new_nodes)
@@ -810,21 +811,27 @@ const Scene& Simulation::scene() const { return impl_->scene; }
 const TetMesh& Simulation::mesh() const { return impl_->model->mesh(); }
 
 DeformedSurface Simulation::surface() const {
-  DeformedSurface s;
-  const TetMesh& m = impl_->model->mesh();
-  const Vector& u = impl_->model->displacement();
-  s.positions.resize(m.nodes.size());
-  s.displacement.resize(m.nodes.size());
-  for (int i = 0; i < m.num_nodes(); ++i) {
-    const Vec3 ui = u.segment<3>(3 * i);
-    s.positions[i] = m.nodes[i] + ui;
-    s.displacement[i] = ui.norm();
-  }
+  SurfaceSnapshot s = surface_snapshot();
+  DeformedSurface d = s.compute();
+  impl_->model->adopt_recovery(s.displacement);
+  return d;
+}
+
+SurfaceSnapshot Simulation::surface_snapshot() const {
+  SurfaceSnapshot s;
+  s.version = impl_->surface_version;
+  s.rest = impl_->model->mesh().nodes;
+  s.displacement = impl_->model->displacement_snapshot();
   s.triangles = impl_->surface_tree.surface().triangles;
   return s;
 }
 
+void Simulation::adopt_recovery(const SurfaceSnapshot& computed) {
+  impl_->model->adopt_recovery(computed.displacement);
+}
+
 std::uint64_t Simulation::surface_version() const { return impl_->surface_version; }
+std::uint64_t Simulation::mesh_version() const { return impl_->mesh_version; }
 
 ModelCounts Simulation::counts() const {
   ModelCounts c;
@@ -869,19 +876,6 @@ const std::vector<double>& Simulation::tet_size_classes() const {
   return impl_->cut_state.origin_volume;
 }
 
-std::string Simulation::mesh_hash() const {
-  // FNV-1a over the topology and the rest positions' bits: equal meshes, equal hashes.
-  std::uint64_t h = 1469598103934665603ull;
-  auto mix = [&h](const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-  };
-  const TetMesh& m = impl_->model->mesh();
-  for (const Vec3& x : m.nodes) mix(x.data(), 3 * sizeof(double));
-  for (const Tet& t : m.tets) mix(t.data(), 4 * sizeof(int));
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
+std::string Simulation::mesh_hash() const { return stc::mesh_hash(impl_->model->mesh()); }
 
 }  // namespace stc

@@ -6,4 +6,5 @@ list(APPEND TISSUE_CORE_SOURCES
   src/simulation/simulation.cpp
   src/simulation/simulation_output.cpp
   src/simulation/step_times.cpp
+  src/simulation/surface_snapshot.cpp
 )

@@ -7,36 +7,60 @@
 
 namespace stc {
 
-// Eigen's wrapper drives CHOLMOD directly: cholmod_analyze + cholmod_factorize with
-// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), and cholmod_solve on a whole
-// dense block of right-hand sides at once.
+// Eigen's wrapper drives CHOLMOD's factorization: cholmod_analyze + cholmod_factorize with
+// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T). Solves call cholmod_solve on
+// the factor directly, each with its own cholmod_common: Eigen's solve() goes through the one
+// cholmod_common it keeps (workspace counters, status), so two threads solving with one
+// factor would race on it. The factor itself is only read by cholmod_solve, so a const
+// SparseCholesky may be shared by threads (the condensed part's factor: the loop and the ROS
+// display thread, recovery/).
+template <typename Llt>
+struct FactorOf : Llt {
+  cholmod_factor* factor() const { return this->m_cholmodFactor; }
+};
+
 namespace {
 
 using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-// Eigen's wrapper with CHOLMOD's factor in view: where a failed factorization stopped
-// (L->minor, in the permuted order L->Perm; exact for a simplicial factor, while a supernodal
-// one reports its supernode's first column).
-class SimplicialWithFactor : public Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> {
- public:
-  int failed_column() const {
-    const cholmod_factor* l = m_cholmodFactor;
-    if (!l || l->minor >= l->n) return -1;
-    return l->Perm ? static_cast<const int*>(l->Perm)[l->minor] : static_cast<int>(l->minor);
-  }
-};
+// Where a failed factorization stopped: L->minor, in the permuted order L->Perm (exact for a
+// simplicial factor; a supernodal one reports its supernode's first column).
+int failed_column(const cholmod_factor* l) {
+  if (!l || l->minor >= l->n) return -1;
+  return l->Perm ? static_cast<const int*>(l->Perm)[l->minor] : static_cast<int>(l->minor);
+}
 
 }  // namespace
 
 struct SparseCholesky::Impl {
-  Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower> supernodal;
-  Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower> simplicial;
+  FactorOf<Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower>> supernodal;
+  FactorOf<Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower>> simplicial;
   CholeskyMethod method = CholeskyMethod::kSupernodal;
 
-  template <typename Rhs>
-  Rhs solve(const Rhs& b) const {
-    if (method == CholeskyMethod::kSimplicial) return simplicial.solve(b);
-    return supernodal.solve(b);
+  // X = A^-1 B, B column-major with rows() rows. Thread-safe (see above).
+  Eigen::MatrixXd solve(const double* b, int rows, int cols) const {
+    cholmod_factor* factor =
+        method == CholeskyMethod::kSimplicial ? simplicial.factor() : supernodal.factor();
+    cholmod_common common;
+    cholmod_start(&common);
+    common.print = 0;
+    cholmod_dense rhs{};
+    rhs.nrow = rhs.d = static_cast<size_t>(rows);
+    rhs.ncol = static_cast<size_t>(cols);
+    rhs.nzmax = rhs.nrow * rhs.ncol;
+    rhs.x = const_cast<double*>(b);  // read only: cholmod_solve writes a new matrix
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor, &rhs, &common);
+    if (!x) {
+      cholmod_finish(&common);
+      throw std::runtime_error("sparse Cholesky (CHOLMOD): the solve failed (out of memory?)");
+    }
+    Eigen::MatrixXd out =
+        Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), rows, cols);
+    cholmod_free_dense(&x, &common);
+    cholmod_finish(&common);
+    return out;
   }
 };
 
@@ -85,24 +109,24 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
 
 int SparseCholesky::first_failing_column(const SparseMatrix& a) {
   if (a.rows() == 0) return -1;
-  SimplicialWithFactor probe;
+  FactorOf<Eigen::CholmodSimplicialLLT<ColMatrix, Eigen::Lower>> probe;
   probe.cholmod().print = 0;
   probe.cholmod().nmethods = 1;
   probe.cholmod().method[0].ordering = CHOLMOD_AMD;
   probe.compute(ColMatrix(a));
-  return probe.info() == Eigen::Success ? -1 : probe.failed_column();
+  return probe.info() == Eigen::Success ? -1 : failed_column(probe.factor());
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (rows_ == 0 || b.cols() == 0) return Eigen::MatrixXd::Zero(rows_, b.cols());
-  Eigen::MatrixXd x = impl_->solve(b);
-  return x;
+  if (b.rows() != rows_) throw std::invalid_argument("SparseCholesky::solve: size mismatch");
+  return impl_->solve(b.data(), rows_, static_cast<int>(b.cols()));
 }
 
 Vector SparseCholesky::solve(const Vector& b) const {
   if (rows_ == 0) return Vector::Zero(0);
-  Vector x = impl_->solve(b);
-  return x;
+  if (b.size() != rows_) throw std::invalid_argument("SparseCholesky::solve: size mismatch");
+  return impl_->solve(b.data(), rows_, 1);
 }
 
 void solve_direct(const SparseMatrix& a, const Vector& b, Vector& x,

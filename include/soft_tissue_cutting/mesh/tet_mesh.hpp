@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace stc {
@@ -37,5 +38,8 @@ struct TetMesh {
 double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 double tet_volume(const TetMesh& mesh, int tet);
 double total_volume(const TetMesh& mesh);
+// FNV-1a over the topology and the rest positions' bits (not cut_faces), 16 hex digits:
+// equal meshes, equal hashes (replays must agree).
+std::string mesh_hash(const TetMesh& mesh);
 
 }  // namespace stc

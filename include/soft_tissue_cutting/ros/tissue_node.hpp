@@ -2,18 +2,24 @@
 // stc::Simulation; this class owns the threads, the topics, services and parameters. One file
 // per job (src/ros/): tissue_node.cpp wiring, node_params.cpp parameters, scalpel_input.cpp
 // topic/tf2 poses, simulation_loop.cpp the loop (and ~cut slices), node_publishing.cpp
-// messages, node_services.cpp services, node_diagnostics.cpp /diagnostics. Message building
+// the loop's messages, node_display.cpp the display thread's, node_services.cpp services,
+// node_diagnostics.cpp /diagnostics. Message building
 // that needs no master is in the tissue_ros library (conversions, markers, pose_input,
 // loop_monitor, log_text).
 //
-// Threads (docs/ROS.md (threads)): the simulation loop runs in its own std::thread at ~rate;
-// ROS callbacks (pose input, services, dynamic_reconfigure) run on an AsyncSpinner; a third
-// thread publishes /diagnostics from LoopMonitor without ever taking `sim_mutex_`, so a busy
-// simulation is still reported. `sim_mutex_` guards the Simulation and is held for one step
-// (or one ~cut slice) at a time: ~cut queues its path for the loop, ~reset builds the fresh
-// Simulation outside the lock and swaps it in, ~save copies the state and writes outside it.
-// Surface and marker messages are published while holding `sim_mutex_`, so their order on
-// the wire is the order of the states they show.
+// Threads (docs/ROS.md (threads)): the simulation loop runs in its own std::thread at ~rate
+// and publishes ~stats and ~scalpel/wrench; ROS callbacks (pose input, services,
+// dynamic_reconfigure) run on an AsyncSpinner; the display thread publishes ~surface,
+// ~markers and ~mesh_hash at ~display_rate (node_display.cpp); a fourth thread publishes
+// /diagnostics from LoopMonitor without ever taking `sim_mutex_`, so a busy simulation is
+// still reported. `sim_mutex_` guards the Simulation and is held for one step (or one ~cut
+// slice) at a time: ~cut queues its path for the loop, ~reset builds the fresh Simulation
+// outside the lock and swaps it in, ~save copies the state and writes outside it, and the
+// display thread only copies under it (Simulation::surface_snapshot): the recovery of u_S,
+// the shading and the publishing run outside it, so a step never waits for them. Display
+// messages go out under `display_mutex_`, newest state last: a refresh overtaken by a newer
+// one (the display thread's by ~reset's) is dropped, so their order on the wire is the order
+// of the states they show.
 #pragma once
 
 #include "soft_tissue_cutting/ros/loop_monitor.hpp"
@@ -38,12 +44,14 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -57,8 +65,9 @@ class TissueNode {
   TissueNode(const TissueNode&) = delete;
   TissueNode& operator=(const TissueNode&) = delete;
 
-  void start();  // publishes the initial state, starts the loop and diagnostics threads
-  void stop();   // joins them; queued ~cut requests are answered
+  // Publishes the initial state, starts the loop, display and diagnostics threads.
+  void start();
+  void stop();  // joins them; queued ~cut requests are answered
 
  private:
   // A ~cut request waiting for (or being inserted by) the loop.
@@ -93,11 +102,36 @@ class TissueNode {
                            const ros::Time& stamp, double rate_hz);
   // The last non-converged solve's reason, for /diagnostics (under info_mutex_).
   void remember_solver_failure(const std::string& why);
-  void publish_display_locked(const StepStats& s, const ros::Time& stamp);
-  void publish_surface_locked(const ros::Time& stamp);
-  void publish_markers_locked(const ros::Time& stamp, const DeformedSurface* surface = nullptr);
-  // sim_->surface(), its time kept for ~stats recovery_ms.
-  DeformedSurface timed_surface_locked();
+
+  // the display (node_display.cpp). One refresh of ~surface / ~markers / ~mesh_hash: what it
+  // shows, copied under sim_mutex_ (display_frame_locked), computed and published outside it
+  // (publish_frame).
+  using MeshKey = std::pair<std::uint64_t, std::uint64_t>;  // (sim_generation_, mesh_version)
+  struct DisplayFrame {
+    std::uint64_t generation = 0, version = 0;  // the state shown (sim_generation_, version)
+    ros::Time stamp;
+    bool surface = false;                     // ~surface (and ~mesh_hash) too, not ~markers only
+    std::optional<SurfaceSnapshot> snapshot;  // a new state: its surface is computed
+    std::shared_ptr<const DeformedSurface> shown;  // else the surface last published
+    std::optional<TetMesh> mesh;                   // the mesh changed: its hash
+    MeshKey mesh_key{};
+    OperationRegion region;
+    double blade_length = 0;
+    std::optional<BladePose> blade;
+    bool cutting = false;
+    std::vector<Vec3> contact_points;
+  };
+  // A computed snapshot, handed back to the model by the display thread's next refresh.
+  struct Recovered {
+    std::uint64_t generation = 0;
+    SurfaceSnapshot snapshot;
+  };
+  void display_thread();
+  // Caller holds sim_mutex_. nullopt: nothing to refresh. force: ~surface from the current
+  // state now (start, ~reset).
+  std::optional<DisplayFrame> display_frame_locked(bool force);
+  void publish_frame(DisplayFrame frame);  // caller holds no lock
+  void publish_display_now();              // the current state, on the calling thread
 
   // services (node_services.cpp)
   bool on_cut(soft_tissue_cutting::Cut::Request& req, soft_tissue_cutting::Cut::Response& res);
@@ -134,7 +168,7 @@ class TissueNode {
   std::unique_ptr<dynamic_reconfigure::Server<soft_tissue_cutting::TissueConfig>> reconfigure_;
   diagnostic_updater::Updater diagnostics_;
 
-  std::thread thread_, diagnostics_thread_;
+  std::thread thread_, display_thread_, diagnostics_thread_;
   std::atomic<bool> running_{false};
   std::chrono::steady_clock::time_point started_;
 
@@ -155,16 +189,22 @@ class TissueNode {
   std::optional<RegionMoveStats> region_moves_;  // `follow` region: as of the last step
   std::uint64_t steps_ = 0;                      // loop thread
 
-  // Display bookkeeping (under sim_mutex_).
-  std::uint64_t published_version_ = 0;
-  // surface versions restart with each fresh Simulation: ~reset bumps sim_generation_.
-  std::uint64_t sim_generation_ = 0, published_generation_ = ~std::uint64_t{0};
+  // surface versions restart with each fresh Simulation: ~reset bumps it (under sim_mutex_).
+  std::uint64_t sim_generation_ = 0;
+  // Display bookkeeping: what is on the wire (under display_mutex_; taken after sim_mutex_
+  // when both are held).
+  std::mutex display_mutex_;
+  std::uint64_t published_version_ = 0, published_generation_ = 0;
   bool published_any_ = false;
   ros::WallTime last_surface_pub_, last_markers_pub_;
   std::string last_hash_;
-  std::optional<BladePose> shown_blade_;  // blade in the last ~markers
+  MeshKey hashed_mesh_{~std::uint64_t{0}, 0};  // the mesh the last ~mesh_hash check hashed
+  std::shared_ptr<const DeformedSurface> shown_surface_;  // the last ~surface's
+  std::optional<BladePose> shown_blade_;                  // blade in the last ~markers
   bool shown_cutting_ = false;
-  double last_recovery_ms_ = 0;  // the last ~surface/~markers refresh (recovery on demand)
+  std::optional<Recovered> recovered_;
+  // The display thread's last surface computation (u_S recovered there when stale), ms.
+  std::atomic<double> last_recovery_ms_{0};
 };
 
 }  // namespace ros_io

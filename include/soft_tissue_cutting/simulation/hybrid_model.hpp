@@ -70,6 +70,14 @@ class HybridModel {
   const Vector& displacement() const;
   // O and I current; S and Q as last recovered (the per-step contact and cutting use this).
   const Vector& operation_displacement() const { return u_; }
+  // displacement() to be recovered later, on any thread, without this model: u copied and
+  // the condensed part shared (recovery/surface_recovery.hpp). Cheap: no solve.
+  DisplacementSnapshot displacement_snapshot() const;
+  // Takes over the S and Q entries of a recovered snapshot of this model, so displacement()
+  // need not solve them again; ignored if the snapshot is not recovered or was taken through
+  // another condensation or stiffness (a replaced model, a new E). Touches only the recovery
+  // cache displacement() fills.
+  void adopt_recovery(const DisplacementSnapshot& recovered) const;
   // Kept for callers of the former two-stage recovery: displacement() recovers Q too.
   void recover_interior();
   // How many recoveries of u_S, u_Q ran (for tests and benchmarks).
@@ -146,12 +154,14 @@ class HybridModel {
   std::vector<std::uint8_t> held_;   // per node (set_held_nodes)
   ElementStiffnessCache elements_;
   Partition partition_;
-  CondensedPart condensed_;
+  // Never changed once condensed (its dense K0 is dropped: k0_padded_ holds K0); shared with
+  // displacement snapshots.
+  std::shared_ptr<const CondensedPart> condensed_;
   double condensed_scale_ = 1.0;    // E now / E at condensation time
   DofMap dofs_;                     // hybrid system over free DOFs of O u I
   std::vector<int> interface_row_;  // free interface DOF k -> hybrid row
   SparseMatrix a_;
-  SparseMatrix k0_padded_;  // K0 as a sparse block (3|I|_free square), see rebuild
+  SparseMatrix k0_padded_;  // K0 as a sparse block (3|I|_free square), at the current E
   Vector b_;
   // u_ is mutable for the on-demand recovery of its S and Q entries in displacement().
   mutable Vector u_;

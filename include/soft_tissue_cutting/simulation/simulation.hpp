@@ -6,7 +6,8 @@
 #include "soft_tissue_cutting/gpu/gl_context_options.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
-#include "soft_tissue_cutting/simulation/model_counts.hpp"  // ModelCounts
+#include "soft_tissue_cutting/simulation/model_counts.hpp"      // ModelCounts
+#include "soft_tissue_cutting/simulation/surface_snapshot.hpp"  // DeformedSurface
 
 #include <chrono>
 #include <cstdint>
@@ -98,14 +99,6 @@ struct PathCut {
   bool done() const { return !refusal.empty() || next >= poses.size(); }
 };
 
-// The visible deformed surface: operation-part surface including cut faces, plus the
-// condensed surface S (docs/DESIGN.md eq. (12)).
-struct DeformedSurface {
-  std::vector<Vec3> positions;       // deformed position of every mesh node
-  std::vector<double> displacement;  // |u| per node, m
-  std::vector<BoundaryTriangle> triangles;
-};
-
 class Simulation {
  public:
   explicit Simulation(Scene scene, SimulationOptions options = {});
@@ -139,8 +132,18 @@ class Simulation {
 
   const Scene& scene() const;
   const TetMesh& mesh() const;
+  // The drawn surface now: surface_snapshot().compute(), its recovery kept by the model.
   DeformedSurface surface() const;
+  // What surface() is computed from, copied (no solve): compute() it later on any thread,
+  // e.g. outside the lock the caller guards this Simulation with (surface_snapshot.hpp).
+  SurfaceSnapshot surface_snapshot() const;
+  // Hands the recovery a computed snapshot ran back to the model, so the next surface() or
+  // full_displacement() need not solve for u_S again; ignored if the model was since replaced
+  // (reset, region move) or rescaled. Cheap (copies).
+  void adopt_recovery(const SurfaceSnapshot& computed);
   std::uint64_t surface_version() const;  // changes whenever the drawn surface changes
+  // Changes whenever mesh() (topology or rest positions: mesh_hash) may have changed.
+  std::uint64_t mesh_version() const;
   ModelCounts counts() const;
   const StepStats& last_stats() const;
   std::string backend() const;                    // solver actually in use: "cpu" or "gl"

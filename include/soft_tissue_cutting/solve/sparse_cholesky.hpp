@@ -43,7 +43,9 @@ class SparseCholesky {
   // -1 if `a` is positive definite. A diagnosis for failures (it factors `a` once more).
   static int first_failing_column(const SparseMatrix& a);
 
-  // X = A^-1 B for all columns of B in one CHOLMOD call.
+  // X = A^-1 B for all columns of B in one CHOLMOD call. Thread-safe: the factor is never
+  // changed after construction and each call has its own CHOLMOD workspace, so threads may
+  // share one factor (the condensed part's, recovered on the ROS display thread).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   Vector solve(const Vector& b) const;
   int rows() const { return rows_; }
