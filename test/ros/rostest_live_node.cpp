@@ -154,7 +154,8 @@ TEST_F(Fixture, LongCutKeepsTheLoopPublishing) {
       "%.3f s, %d /diagnostics; %u tets split, %u cut faces\n",
       cut.request.poses.size(), seconds, during, during / seconds, gap, diag_during,
       cut.response.tets_split, cut.response.cut_faces);
-  EXPECT_GT(seconds, 0.5) << "too short to tell; the path should need many slices";
+  // 0.35 s here since a slice's sweeps share one factorization (was > 0.5 s): still ~30 steps.
+  EXPECT_GT(seconds, 0.2) << "too short to tell; the path should need many slices";
   EXPECT_GT(during, 0.3 * 100 * seconds) << "the loop must keep stepping during a long ~cut";
   // One sweep cannot be split (~0.1 s on the thigh): no gap much longer than that.
   EXPECT_LT(gap, 1.0) << "~stats stopped for a while during the ~cut";
