@@ -28,6 +28,8 @@ std::vector<MeshPiece> face_connected_pieces(const TetMesh& mesh);
 // The smallest of `pieces` that has `node` (a node shared by several through a hinge belongs
 // to each); nullptr if none has it.
 const MeshPiece* smallest_piece_with_node(const std::vector<MeshPiece>& pieces, int node);
+// The answer points into `pieces`: never into a temporary.
+const MeshPiece* smallest_piece_with_node(std::vector<MeshPiece>&& pieces, int node) = delete;
 
 // The pieces not held rigidly: components connected by shared FACES (a piece hanging on by a
 // node or an edge can rotate about it) with fewer than three non-collinear anchored nodes

@@ -191,7 +191,8 @@ TEST(CutCases, TheFactorPointsAtAPieceNothingHolds) {
   const int dof = solver->singular_dof();
   ASSERT_GE(dof, 0) << "a severed piece nothing holds must not factor";
   const int node = dofs.global_of[static_cast<size_t>(dof)] / 3;
-  const MeshPiece* piece = smallest_piece_with_node(face_connected_pieces(mesh), node);
+  const std::vector<MeshPiece> pieces = face_connected_pieces(mesh);
+  const MeshPiece* piece = smallest_piece_with_node(pieces, node);
   ASSERT_NE(piece, nullptr);
   EXPECT_EQ(piece->tets, free[0].tets) << "node " << node << " at " << mesh.nodes[node].transpose();
   // The piece held (its DOFs left out of the factor): it factors, and says so.
