@@ -239,17 +239,19 @@ class CpuCgSolver final : public LinearSolver {
     std::vector<int> index(static_cast<size_t>(a_.rows()), -1);
     for (size_t i = 0; i < kept_.size(); ++i)
       index[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<size_t>(a_.nonZeros()));
-    for (int c = 0; c < a_.outerSize(); ++c)
-      for (SparseMatrix::InnerIterator it(a_, c); it; ++it) {
-        const int i = index[static_cast<size_t>(it.row())],
-                  j = index[static_cast<size_t>(it.col())];
-        if (i >= 0 && j >= 0) t.emplace_back(i, j, it.value());
-      }
+    // Row by row in kept order: the renumbering is increasing, so each row's columns stay
+    // sorted and the compressed arrays are written directly (no triplets, no sort).
     const auto n = static_cast<Eigen::Index>(kept_.size());
     SparseMatrix out(n, n);
-    out.setFromTriplets(t.begin(), t.end());
+    out.reserve(a_.nonZeros());
+    for (Eigen::Index i = 0; i < n; ++i) {
+      out.startVec(i);
+      for (SparseMatrix::InnerIterator it(a_, kept_[static_cast<size_t>(i)]); it; ++it) {
+        const int j = index[static_cast<size_t>(it.index())];
+        if (j >= 0) out.insertBack(i, j) = it.value();
+      }
+    }
+    out.finalize();
     return out;
   }
 
