@@ -380,7 +380,7 @@ struct Simulation::Impl {
                           (piece ? std::to_string(piece->tets.size()) + " tets, " +
                                        std::to_string(anchors) + " anchored nodes"
                                  : std::string("in no operation tet")) +
-                          "); the solve will not converge until ~reset");
+                          "); the solve will not converge until a reset");
         return;
       }
       const Vector& u = model->operation_displacement();
