@@ -336,19 +336,30 @@ struct Simulation::Impl {
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
   // it is.
   void hold_free_pieces() {
-    if (follower) return hold_free_pieces_anywhere();
-    // Only part 1 can come free: every piece of part 2 reaches a fixed or an interface node
-    // (its condensation is nonsingular), and those are anchored.
-    const TetMesh part1 = tet_subset(model->mesh(), model->partition().operation_tets);
-    const std::vector<MeshPiece> pieces = free_pieces(part1, anchored);
-    for (const MeshPiece& piece : pieces) {
-      for (int n : piece.nodes) {
-        held[n] = model->operation_displacement().segment<3>(3 * n);
-        anchored[static_cast<size_t>(n)] = 1;
-      }
-      ++free_pieces_held;
-    }
+    const std::vector<MeshPiece> pieces = free_pieces(piece_search_mesh(), anchored);
+    for (const MeshPiece& piece : pieces) hold_piece(piece);
     log_pieces_held(pieces);
+  }
+
+  // Where pieces can come free. A fixed region: only part 1 (every piece of part 2 reaches a
+  // fixed or an interface node - its condensation is nonsingular - and those are anchored).
+  // `follow`: a piece may reach into the condensed part (cut there before a move), so the whole
+  // mesh.
+  TetMesh piece_search_mesh() const {
+    return follower ? model->mesh() : tet_subset(model->mesh(), model->partition().operation_tets);
+  }
+
+  // Holds every node of `piece` where it is. `follow`: its O and I nodes are held now; its
+  // condensed nodes follow them through the condensation, and every later move keeps the whole
+  // piece in part 1, where its nodes are held too (adopt_moved_region).
+  void hold_piece(const MeshPiece& piece) {
+    const Vector& u = model->operation_displacement();
+    for (int n : piece.nodes) {
+      if (!follower || operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
+      anchored[static_cast<size_t>(n)] = 1;
+      if (follower) held_piece_nodes.push_back(n);
+    }
+    ++free_pieces_held;
   }
 
   // docs/SCENE.md "Cut invariants": the system stays positive definite on its free DOFs. The
@@ -364,8 +375,7 @@ struct Simulation::Impl {
       const int dof = model->solver().singular_dof();
       if (dof < 0) return;
       const int node = model->hybrid_dofs().global_of[static_cast<size_t>(dof)] / 3;
-      const TetMesh searched =
-          follower ? model->mesh() : tet_subset(model->mesh(), model->partition().operation_tets);
+      const TetMesh searched = piece_search_mesh();
       const std::vector<MeshPiece> pieces = face_connected_pieces(searched);
       const MeshPiece* piece = smallest_piece_with_node(pieces, node);
       int anchors = 0;
@@ -383,13 +393,7 @@ struct Simulation::Impl {
                           "); the solve will not converge until a reset");
         return;
       }
-      const Vector& u = model->operation_displacement();
-      for (int n : piece->nodes) {  // as hold_free_pieces(_anywhere) holds a piece
-        if (!follower || operation_or_interface(*model, n)) held[n] = u.segment<3>(3 * n);
-        anchored[static_cast<size_t>(n)] = 1;
-        if (follower) held_piece_nodes.push_back(n);
-      }
-      ++free_pieces_held;
+      hold_piece(*piece);
       if (options.log)
         options.log(LogLevel::kWarn, what + ": the piece of " + std::to_string(piece->tets.size()) +
                                          " tets around it (" + std::to_string(anchors) +
@@ -409,26 +413,6 @@ struct Simulation::Impl {
             ? "a piece of " + std::to_string(tets) + " tets was cut free; it is held in place"
             : std::to_string(pieces.size()) + " pieces (" + std::to_string(tets) +
                   " tets in all) were cut free; they are held in place");
-  }
-
-  // `follow`: a piece may reach into the condensed part (cut there before a move), so pieces
-  // are looked for in the whole mesh. Its O and I nodes are held now; its condensed nodes
-  // follow them through the condensation, and every later move keeps the whole piece in
-  // part 1, where its nodes are held too (adopt_moved_region).
-  void hold_free_pieces_anywhere() {
-    const Partition& p = model->partition();
-    const std::vector<MeshPiece> pieces = free_pieces(model->mesh(), anchored);
-    for (const MeshPiece& piece : pieces) {
-      for (int n : piece.nodes) {
-        const NodeSet set = p.node_set[static_cast<size_t>(n)];
-        if (set == NodeSet::kOperation || set == NodeSet::kInterface)
-          held[n] = model->operation_displacement().segment<3>(3 * n);
-        anchored[static_cast<size_t>(n)] = 1;
-        held_piece_nodes.push_back(n);
-      }
-      ++free_pieces_held;
-    }
-    log_pieces_held(pieces);
   }
 
   // ---- `follow`: the operation region moves with the blade (region_follower.hpp)
