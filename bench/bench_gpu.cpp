@@ -11,9 +11,11 @@
 #include "common/test_matrices.hpp"
 #include "gpu/egl_context.hpp"
 #include "gpu/gl_cg.hpp"
+#include "gpu/gl_reduction.hpp"
 #include "gpu/gl_vector.hpp"
 
 #include <benchmark/benchmark.h>
+#include <epoxy/gl.h>
 
 #include <chrono>
 #include <cmath>
@@ -69,6 +71,15 @@ const SparseMatrix& scaling(int dof) {
   return it->second;
 }
 
+// Untimed runs before a benchmark's timed ones (the first is a shader compile on any driver).
+constexpr int kWarmUp = 4;
+
+// llvmpipe renders on the CPU: the 1M-row runs take seconds there and get fixed iteration
+// counts; a hardware GPU runs for a minimum time like any other benchmark.
+bool software_renderer() {
+  return gl().ctx && gl().ctx->renderer().find("llvmpipe") != std::string::npos;
+}
+
 std::string short_renderer() {
   const std::string& r = gl().ctx->renderer();
   return r.substr(0, r.find(" ("));
@@ -82,7 +93,9 @@ void gpu_spmv(benchmark::State& state, const SparseMatrix& a, SpmvLayout layout)
   Texture x, y;
   upload_vector(x, spmv.vec_shape(), random_vector(a.rows(), 1));
   upload_vector(y, spmv.vec_shape(), Vector::Zero(a.rows()));
-  spmv.multiply(x, y);  // warm-up: shaders compile lazily in the driver
+  // Warm-up: shaders compile lazily, and a real GPU's driver finishes freshly uploaded textures
+  // in the first draws (on an H200 the first 1M-row products took twice as long).
+  for (int i = 0; i < kWarmUp; ++i) spmv.multiply(x, y);
   g.runner->finish();
   for (auto _ : state) {
     spmv.multiply(x, y);
@@ -106,7 +119,7 @@ void gpu_cg(benchmark::State& state, const SparseMatrix& a, SpmvLayout layout, i
   Vector r0 = random_vector(a.rows(), 2);
   r0 /= r0.norm();
   cg.start(r0);
-  cg.iterate(1);
+  cg.iterate(kWarmUp);  // warm-up, as in gpu_spmv
   cg.residual_norm2();
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -120,6 +133,29 @@ void gpu_cg(benchmark::State& state, const SparseMatrix& a, SpmvLayout layout, i
   state.counters["passes_per_iter"] = cg.passes_per_iteration();
   state.counters["spmv_passes"] = spmv.passes();
   state.SetLabel(layout_name(layout) + " on " + short_renderer());
+}
+
+// One dot product (the CG's reduction, GlReduction::dot) into a 1x1 texture; finish() waits
+// for it, as CG's read-back of r.r does.
+void gpu_dot(benchmark::State& state, int n, int fan_in = GlReduction::kFanIn) {
+  Gl& g = gl();
+  g.ctx->make_current();
+  const TextureShape shape = vector_shape(n, 2048, g.ctx->max_texture_size());
+  GlReduction reduction(*g.runner, fan_in);
+  reduction.configure(shape);
+  Texture a, b, target;
+  upload_vector(a, shape, random_vector(n, 1));
+  upload_vector(b, shape, random_vector(n, 2));
+  target.allocate(1, 1, GL_RG32F);
+  for (int i = 0; i < kWarmUp; ++i) reduction.dot(a, b, target);  // warm-up, as in gpu_spmv
+  g.runner->finish();
+  for (auto _ : state) {
+    reduction.dot(a, b, target);
+    g.runner->finish();
+  }
+  state.counters["n"] = double(n);
+  state.counters["passes"] = reduction.passes();
+  state.SetLabel("reduction on " + short_renderer());
 }
 
 void cpu_spmv(benchmark::State& state, const SparseMatrix& a) {
@@ -199,11 +235,28 @@ int register_all() {
         ->MinTime(0.05);
   }
   // Scaling of whole CG iterations (3D elasticity-like, 20 off-diagonal non-zeros per row).
-  // Fixed iteration counts (and 4 instead of 8 CG iterations per read-back at 1M) keep the
-  // 1M runs on llvmpipe to seconds.
+  // On llvmpipe, fixed iteration counts (and 4 instead of 8 CG iterations per read-back at 1M)
+  // keep the 1M runs to seconds.
   for (int dof : {10002, 100002, 1000002}) {
     const std::string tag = "/dof:" + std::to_string(dof);
-    const int bench_iters = dof > 500000 ? 1 : dof > 50000 ? 4 : 0;  // 0: automatic
+    const int bench_iters = !software_renderer() ? 0
+                            : dof > 500000       ? 1
+                            : dof > 50000        ? 4
+                                                 : 0;  // 0: automatic
+    // The parts of one CG iteration: the SpMV and one of its two dot products.
+    if (g.ctx) {
+      benchmark::RegisterBenchmark(
+          ("Scaling_SpMV/row_loop" + tag).c_str(),
+          [=](benchmark::State& s) { gpu_spmv(s, scaling(dof), SpmvLayout::RowLoop); })
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.05);
+      // Same-run comparison with the first design's 2 x 2 reduction passes.
+      for (int fan_in : {2, 4})
+        benchmark::RegisterBenchmark(("Scaling_Dot/fan_in:" + std::to_string(fan_in) + tag).c_str(),
+                                     [=](benchmark::State& s) { gpu_dot(s, dof, fan_in); })
+            ->Unit(benchmark::kMillisecond)
+            ->MinTime(0.05);
+    }
     for (SpmvLayout l : kLayouts) {
       if (!g.ctx) break;
       auto* b = benchmark::RegisterBenchmark(

@@ -3,9 +3,11 @@
 // 14, "Headless EGL compute"): a missing context is a failure, not a skip.
 #include "common/test_matrices.hpp"
 #include "gpu/egl_context.hpp"
+#include "gpu/gl_reduction.hpp"
 #include "gpu/gl_spmv.hpp"
 #include "gpu/gl_vector.hpp"
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -87,6 +89,43 @@ TEST_P(GpuSpmv, Table2MatrixHasStatedMaxRow) {
   EXPECT_EQ(max_offdiag_row(a), 237);
   int passes = 0;
   EXPECT_LE(spmv_error(a, &passes), 1e-6);
+}
+
+// The dot products of CG (GlReduction): any fan-in, any vector length (texture shapes that are
+// not multiples of the block, a single texel), against a double dot, to float32 accuracy.
+TEST(GpuReduction, DotMatchesDoubleForAnyFanInAndLength) {
+  std::string why;
+  auto ctx = EglContext::create(GlContextOptions{}, &why);
+  ASSERT_TRUE(ctx) << "EGL must work on llvmpipe here: " << why;
+  {
+    ShaderLibrary shaders(ctx->api(), "");
+    PassRunner runner(shaders);
+    for (int fan_in : {2, 3, GlReduction::kFanIn})
+      for (int n : {1, 5, 1000, 20100}) {
+        const TextureShape shape = vector_shape(n, 2048, ctx->max_texture_size());
+        const Vector a = random_vector(n, 5), b = random_vector(n, 6);
+        Texture ta, tb, target;
+        upload_vector(ta, shape, a);
+        upload_vector(tb, shape, b);
+        target.allocate(1, 1, GL_RG32F);
+        GlReduction reduction(runner, fan_in);
+        reduction.configure(shape);
+        reduction.dot(ta, tb, target);
+        const std::vector<float> got = target.read_float(2);
+        const Vector af = a.cast<float>().cast<double>(), bf = b.cast<float>().cast<double>();
+        // float32 sums of n terms: relative to sum |a_i b_i| (a.b itself may nearly cancel).
+        const double scale_ab = af.cwiseProduct(bf).cwiseAbs().sum();
+        EXPECT_NEAR(got[0], af.dot(bf), 1e-6 * scale_ab) << "fan-in " << fan_in << ", n " << n;
+        EXPECT_NEAR(got[1], af.squaredNorm(), 1e-6 * af.squaredNorm())
+            << "fan-in " << fan_in << ", n " << n;
+        const int side = std::max(shape.width, shape.height);
+        int expected_passes = 1;  // the first pass, then one per level down to 1 x 1
+        for (int m = (side + fan_in - 1) / fan_in; m > 1; m = (m + fan_in - 1) / fan_in)
+          ++expected_passes;
+        EXPECT_EQ(reduction.passes(), expected_passes) << "fan-in " << fan_in << ", n " << n;
+      }
+  }
+  ctx->make_current();
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, GpuSpmv,
