@@ -13,6 +13,7 @@
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
+#include "solve/blas_guard.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -681,6 +682,13 @@ Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl)
   impl_->initial = std::move(scene);
   impl_->options = std::move(options);
   impl_->start();
+  // Correct either way (solve/blas_guard.hpp), but slower when moves or the display thread
+  // factor beside the loop: say so once.
+  if (blas_info().serialized && impl_->options.log)
+    impl_->options.log(LogLevel::kInfo,
+                       "the BLAS is OpenBLAS's single-threaded build, which is not thread-safe: "
+                       "CHOLMOD's calls into it are serialized (install libopenblas0-pthread, "
+                       "./tissue setup, to let them run side by side)");
 }
 
 Simulation::~Simulation() = default;

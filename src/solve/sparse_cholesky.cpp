@@ -1,5 +1,7 @@
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
+#include "solve/blas_guard.hpp"
+
 #include <Eigen/CholmodSupport>
 
 #include <algorithm>
@@ -13,7 +15,8 @@ namespace stc {
 // cholmod_common it keeps (workspace counters, status), so two threads solving with one
 // factor would race on it. The factor itself is only read by cholmod_solve, so a const
 // SparseCholesky may be shared by threads (the condensed part's factor: the loop and the ROS
-// display thread, recovery/).
+// display thread, recovery/). Supernodal factorizations and solves call the BLAS: they hold
+// blas_guard() (solve/blas_guard.hpp), which serializes them when the BLAS is not thread-safe.
 template <typename Llt>
 struct FactorOf : Llt {
   cholmod_factor* factor() const { return this->m_cholmodFactor; }
@@ -51,7 +54,12 @@ struct SparseCholesky::Impl {
     rhs.x = const_cast<double*>(b);  // read only: cholmod_solve writes a new matrix
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor, &rhs, &common);
+    cholmod_dense* x = nullptr;
+    {
+      const auto blas =
+          method == CholeskyMethod::kSimplicial ? std::unique_lock<std::mutex>() : blas_guard();
+      x = cholmod_solve(CHOLMOD_A, factor, &rhs, &common);
+    }
     if (!x) {
       cholmod_finish(&common);
       throw std::runtime_error("sparse Cholesky (CHOLMOD): the solve failed (out of memory?)");
@@ -98,6 +106,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
     info = impl_->simplicial.info();
   } else {
     impl_->supernodal.cholmod().print = 0;
+    const auto blas = blas_guard();
     impl_->supernodal.compute(col);
     info = impl_->supernodal.info();
   }
