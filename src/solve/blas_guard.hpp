@@ -9,6 +9,8 @@
 // matrices CG could not solve). `./tissue setup` installs libopenblas0-pthread instead, which
 // locks. Whatever BLAS the loader picked, these guards make it safe: when the process runs
 // OpenBLAS's single-threaded build, every BLAS-using CHOLMOD call takes one process-wide mutex.
+// The first call also keeps the numeric libraries' own threads out of the loop's way (one
+// OpenBLAS thread per call, CHOLMOD's OpenMP regions inline: see blas_guard.cpp).
 #pragma once
 
 #include <mutex>
@@ -18,8 +20,9 @@ namespace stc {
 
 // What the loaded BLAS is and whether calls into it are serialized (one line, for the log).
 struct BlasInfo {
-  std::string config;       // openblas_get_config(), or "" for a BLAS that is not OpenBLAS
-  bool serialized = false;  // BLAS-using calls take the process-wide mutex
+  std::string config;          // openblas_get_config(), or "" for a BLAS that is not OpenBLAS
+  bool serialized = false;     // BLAS-using calls take the process-wide mutex
+  bool openmp_inline = false;  // CHOLMOD's OpenMP regions run on the calling thread
 };
 const BlasInfo& blas_info();
 

@@ -79,6 +79,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
                                CholeskyOrdering ordering)
     : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
   impl_->method = method;
+  blas_info();  // before CHOLMOD's first call: its threads settled (solve/blas_guard.hpp)
   if (rows_ == 0) return;
   if (ordering == CholeskyOrdering::kAmd)
     for (cholmod_common* c : {&impl_->simplicial.cholmod(), &impl_->supernodal.cholmod()}) {
