@@ -167,12 +167,7 @@ void HybridModel::rebuild_hybrid_system() {
   for (int k = 0; k < idofs.rows(); ++k)
     if (interface_row_[static_cast<size_t>(k)] != k)
       throw std::logic_error("HybridModel: the interface DOFs are not the leading rows");
-  const int n = dofs_.rows();
-  std::vector<Triplet> t;
-  t.reserve(partition_.operation_tets.size() * 144);
-  add_element_triplets(mesh_, elements_, partition_.operation_tets, dofs_.row_of, dofs_.row_of, t);
-  SparseMatrix k1(n, n);
-  k1.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix k1 = assemble_stiffness(mesh_, elements_, partition_.operation_tets, dofs_);
   merge_k0(k1, k0_padded_, a_);
 
   // Right-hand side: f_O, f_I - g0. The loads of the whole mesh, with part 2's gravity kept
