@@ -10,10 +10,10 @@
 namespace stc {
 
 // Eigen's wrapper drives CHOLMOD's factorization: cholmod_analyze + cholmod_factorize with
-// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), of the upper triangle. Solves call cholmod_solve on
-// the factor directly, each with its own cholmod_common: Eigen's solve() goes through the one
-// cholmod_common it keeps (workspace counters, status), so two threads solving with one
-// factor would race on it. The factor itself is only read by cholmod_solve, so a const
+// supernodal = CHOLMOD_SUPERNODAL (or CHOLMOD_SIMPLICIAL, LL^T), of the upper triangle. Solves call
+// cholmod_solve on the factor directly, each with its own cholmod_common: Eigen's solve() goes
+// through the one cholmod_common it keeps (workspace counters, status), so two threads solving with
+// one factor would race on it. The factor itself is only read by cholmod_solve, so a const
 // SparseCholesky may be shared by threads (the condensed part's factor: the loop and the ROS
 // display thread, recovery/). Supernodal factorizations and solves call the BLAS: they hold
 // blas_guard() (solve/blas_guard.hpp), which serializes them when the BLAS is not thread-safe.
