@@ -1,7 +1,9 @@
 // The tissue's current boundary surface at its DEFORMED positions (rest + displacement), in
 // an AABB tree: what the blade is tested against every step. Triangles owned by operation-part
 // tets are the ones the blade can touch (edge_contact.hpp, tip_contact.hpp); the whole closed
-// surface answers point-in-tissue queries by ray parity.
+// surface answers point-in-tissue queries by ray parity. Two trees: the operation part's
+// triangles, rebuilt after every cut, and the rest, which a cut never changes (it stops one
+// element layer before the interface): kept across cuts and only refitted.
 #pragma once
 
 #include "soft_tissue_cutting/collision/aabb_tree.hpp"
@@ -15,7 +17,8 @@ namespace stc {
 class SurfaceBvh {
  public:
   // After every cut (the surface changed). operation_tets: per tet, nonzero = operation part
-  // (empty = all). displacement: per node (empty = rest shape).
+  // (empty = all). displacement: per node (empty = rest shape). The tree of the other
+  // triangles is rebuilt only when they changed (a new partition, a new mesh).
   void build(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
              const std::vector<Vec3>& displacement);
   // The same from a boundary surface the caller already has (e.g. updated from the operation
@@ -37,11 +40,14 @@ class SurfaceBvh {
 
  private:
   void update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement);
-  std::vector<Box3> triangle_boxes() const;
+  std::vector<Box3> triangle_boxes(const std::vector<int>& triangles) const;
   BoundarySurface surface_;
   std::vector<std::uint8_t> operation_;
   std::vector<Vec3> positions_;
-  AabbTree tree_;
+  // Per tree, its triangles (indices into surface_.triangles) in the tree's primitive order.
+  std::vector<int> operation_triangles_, other_triangles_;
+  std::vector<Tri> other_nodes_;  // the other triangles' nodes at the last rebuild of their tree
+  AabbTree operation_tree_, other_tree_;
 };
 
 // Does segment [p, q] cross triangle (a, b, c)? On a hit, s = the segment parameter.

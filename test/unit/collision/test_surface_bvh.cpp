@@ -60,5 +60,61 @@ TEST(CollisionBvh, PointInTissueByRayParity) {
   EXPECT_GT(checked, 300);
 }
 
+// Two trees (operation triangles, the rest): every triangle whose box meets the query's is a
+// candidate (candidates are whole leaves, so the sets themselves depend on the trees), and
+// point-in-tissue answers equal one tree's over every triangle - after a build, after a refit
+// on moved nodes, and after a second build that keeps the other triangles' tree (their set
+// unchanged): the path every cut takes.
+TEST(CollisionBvh, OperationAndOtherTreesAnswerLikeOneTree) {
+  const Scene scene = make_thigh_scene();
+  std::vector<std::uint8_t> operation(scene.mesh.tets.size(), 0);
+  for (size_t t = 0; t < scene.mesh.tets.size(); ++t) {
+    Vec3 c = Vec3::Zero();
+    for (int v : scene.mesh.tets[t]) c += 0.25 * scene.mesh.nodes[v];
+    operation[t] = c.x() > 0.03;  // the +x side of the tube
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.07, 0.07), z(-0.01, 0.106), small(-2e-3, 2e-3);
+  std::vector<Vec3> moved(scene.mesh.nodes.size());
+  for (Vec3& d : moved) d = Vec3(small(rng), small(rng), small(rng));
+  SurfaceBvh split, one;
+  split.build(scene.mesh, operation, {});
+  one.build(scene.mesh, {}, {});
+  int operation_triangles = 0;
+  for (size_t t = 0; t < split.surface().triangles.size(); ++t)
+    operation_triangles += split.is_operation(static_cast<int>(t));
+  ASSERT_GT(operation_triangles, 0);
+  ASSERT_LT(operation_triangles, static_cast<int>(split.surface().triangles.size()));
+  auto same_answers = [&](const char* when) {
+    for (int trial = 0; trial < 300; ++trial) {
+      const Vec3 a(u(rng), u(rng), z(rng)), b = a + Vec3(small(rng), small(rng), small(rng)) * 10;
+      std::vector<int> x = split.near_segment(a, b, 1e-3);
+      std::sort(x.begin(), x.end());
+      Box3 query(a);
+      query.extend(b);
+      query.min().array() -= 1e-3;
+      query.max().array() += 1e-3;
+      for (size_t t = 0; t < split.surface().triangles.size(); ++t) {
+        const Tri& n = split.surface().triangles[t].nodes;
+        Box3 box(split.position(n[0]));
+        box.extend(split.position(n[1]));
+        box.extend(split.position(n[2]));
+        if (box.intersects(query)) {
+          ASSERT_TRUE(std::binary_search(x.begin(), x.end(), static_cast<int>(t)))
+              << when << ", triangle " << t << " missing for segment " << a.transpose();
+        }
+      }
+      ASSERT_EQ(split.contains(a), one.contains(a)) << when << ", point " << a.transpose();
+    }
+  };
+  same_answers("after the build");
+  split.refit(scene.mesh, moved);
+  one.refit(scene.mesh, moved);
+  same_answers("after a refit");
+  split.build(scene.mesh, operation, moved);  // the other triangles' tree kept, refitted
+  one.build(scene.mesh, {}, moved);
+  same_answers("after a second build");
+}
+
 }  // namespace
 }  // namespace stc
