@@ -13,6 +13,11 @@ class ElementStiffnessCache {
  public:
   ElementStiffnessCache() = default;
   ElementStiffnessCache(const TetMesh& mesh, const Material& material);
+  // Copies keep room for the tets later cuts add (reserve_for_cuts).
+  ElementStiffnessCache(const ElementStiffnessCache& other);
+  ElementStiffnessCache& operator=(const ElementStiffnessCache& other);
+  ElementStiffnessCache(ElementStiffnessCache&&) = default;
+  ElementStiffnessCache& operator=(ElementStiffnessCache&&) = default;
 
   // The mesh changed in place: resize to its tet count and recompute the listed tets (indices
   // of replaced or appended tets). Tets not listed keep their matrices.
@@ -26,6 +31,7 @@ class ElementStiffnessCache {
   const Material& material() const { return material_; }
 
  private:
+  void reserve_for_cuts(size_t tets);
   Material material_;
   std::vector<Mat12> matrices_;
 };
