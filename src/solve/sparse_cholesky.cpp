@@ -90,14 +90,25 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
   // are instead of transposed. CHOLMOD is shown the upper triangle (A's lower one, equal to
   // rounding): its analysis orders and builds the elimination tree from the upper triangle, so
   // a lower one is transposed first on every factorization (7 % of the thigh's cutting step).
+  // Only that triangle is passed: CHOLMOD scans every stored entry (and skips the other
+  // triangle's) in its analysis and in the factorization's scatter of A.
   ColMatrix col(a.rows(), a.cols());
-  if (a.isCompressed()) {
-    col.resizeNonZeros(a.nonZeros());
-    std::copy(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1, col.outerIndexPtr());
-    std::copy(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), col.innerIndexPtr());
-    std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), col.valuePtr());
-  } else {
-    col = a;
+  {
+    const SparseMatrix& c = a;
+    int count = 0;
+    for (int r = 0; r < c.outerSize(); ++r)
+      for (SparseMatrix::InnerIterator it(c, r); it; ++it) count += it.col() <= r;
+    col.resizeNonZeros(count);
+    int* outer = col.outerIndexPtr();
+    int* inner = col.innerIndexPtr();
+    double* value = col.valuePtr();
+    int out = 0;
+    for (int r = 0; r < c.outerSize(); ++r) {  // row r of A: column r of the upper triangle
+      outer[r] = out;
+      for (SparseMatrix::InnerIterator it(c, r); it; ++it)
+        if (it.col() <= r) inner[out] = static_cast<int>(it.col()), value[out++] = it.value();
+    }
+    outer[c.outerSize()] = out;
   }
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
