@@ -50,10 +50,14 @@ if [ -f "$WORK/prefix/setup.bash" ]; then
         pid=$!
         rc=0
         python3 "$5/test/doc/judge.py" surface || rc=1
+        player=""
         if [ "$3" = thigh ] && [ $rc -eq 0 ]; then
           rosrun soft_tissue_cutting trajectory_player.py >>"$4" 2>&1 &
+          player=$!
           python3 "$5/test/doc/judge.py" trajectory_player || rc=1
         fi
+        # The player outlives its master otherwise (it waits for one, for ever).
+        if [ -n "$player" ]; then kill -INT $player 2>/dev/null; wait $player || true; fi
         kill -INT $pid; wait $pid || true
         exit $rc' _ "$WORK/prefix" "$port" "$scene" "$log" "$ROOT" 2>&1) || rc=$?
     local name="installed node on ${scene#"$share"/}"
