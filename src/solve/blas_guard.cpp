@@ -32,10 +32,8 @@ BlasInfo detect() {
   // OMP_MAX_ACTIVE_LEVELS).
   using LevelsFn = void (*)(int);
   if (!std::getenv("OMP_THREAD_LIMIT") && !std::getenv("OMP_MAX_ACTIVE_LEVELS"))
-    if (auto set = reinterpret_cast<LevelsFn>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"))) {
+    if (auto set = reinterpret_cast<LevelsFn>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels")))
       set(0);
-      info.openmp_inline = true;
-    }
   return info;
 }
 

@@ -20,9 +20,8 @@ namespace stc {
 
 // What the loaded BLAS is and whether calls into it are serialized (one line, for the log).
 struct BlasInfo {
-  std::string config;          // openblas_get_config(), or "" for a BLAS that is not OpenBLAS
-  bool serialized = false;     // BLAS-using calls take the process-wide mutex
-  bool openmp_inline = false;  // CHOLMOD's OpenMP regions run on the calling thread
+  std::string config;       // openblas_get_config(), or "" for a BLAS that is not OpenBLAS
+  bool serialized = false;  // BLAS-using calls take the process-wide mutex
 };
 const BlasInfo& blas_info();
 
