@@ -33,9 +33,11 @@ struct CutState {
   // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
   // Per node (grown on demand): on the current stroke's cut surface - created on it by a
-  // split, taken onto it by the snap rule, or a copy made by opening it. Every triangle of the
-  // stroke treats these as "on", so a face whose nodes came onto the cut in different sweeps
-  // (a slow blade, a curved path) is still recognised as lying on the cut.
+  // split, taken onto it by the snap rule, or a copy made by opening it. A triangle of the
+  // stroke treats these as "on" where they lie within its snap distance of its plane, and any
+  // of them may be a corner of a face it marks, so a face whose nodes came onto the cut in
+  // different sweeps (a slow blade, a curved or twisting path) is still recognised as lying
+  // on the cut (triangle_cut.cpp).
   std::vector<std::uint8_t> on_stroke;
   std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
 };

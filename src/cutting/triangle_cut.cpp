@@ -126,7 +126,6 @@ bool TriangleClassification::contains(const Vec3& p, double tol) const {
 }
 
 int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int v) {
-  if (is_on_stroke(state, v)) return 0;  // on the stroke's cut surface (cut_state.hpp)
   auto it = side_.find(v);
   if (it != side_.end()) return it->second;
   const double d = distance(mesh, v);
@@ -135,7 +134,12 @@ int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int
   double longest = 0;
   for (int t : state.node_tets[v])
     for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
-  const int s = std::abs(d) <= 1e-9 * longest ? 0 : (d > 0 ? 1 : -1);
+  // A node already on the stroke's cut surface (cut_state.hpp) is on this triangle too when
+  // it lies as near its plane as the snap rule lets a cut lie off the blade. Farther off (a
+  // curved or twisting stroke: the stroke's earlier triangles are not coplanar with this one)
+  // it is classified like any node, so the edges it ends are still split where they cross.
+  const double on = is_on_stroke(state, v) ? snap_tolerance_ : 1e-9;
+  const int s = std::abs(d) <= on * longest ? 0 : (d > 0 ? 1 : -1);
   side_[v] = s;
   return s;
 }
@@ -273,9 +277,11 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       if (mesh.is_cut_face(t, f)) continue;
       const Tet& tet = mesh.tets[t];
       const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
-      if (tri.side(mesh, state, p) != 0 || tri.side(mesh, state, q) != 0 ||
-          tri.side(mesh, state, r) != 0)
-        continue;
+      // Any node on the stroke's cut surface may be a corner: a face in the crease between
+      // two non-coplanar triangles of the stroke has corners on each; the checks below keep
+      // only faces that lie along this triangle.
+      auto on = [&](int v) { return is_on_stroke(state, v) || tri.side(mesh, state, v) == 0; };
+      if (!on(p) || !on(q) || !on(r)) continue;
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
       // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth

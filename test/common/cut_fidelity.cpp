@@ -132,7 +132,8 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
       const double d = nearest_sweep(p, &k);
       if (which < 0 || &p == &points[3]) which = k;
       out.faces_to_sweep = std::max(out.faces_to_sweep, d);
-      out.faces_over_tolerance = std::max(out.faces_over_tolerance, d / tolerance_at(h));
+      if (d / tolerance_at(h) > out.faces_over_tolerance)
+        out.faces_over_tolerance = d / tolerance_at(h), out.worst_face_point = p;
     }
     if (which < 0) continue;
     const double c = f.normal.dot(sweep_normal[static_cast<size_t>(which)]);

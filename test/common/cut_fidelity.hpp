@@ -54,6 +54,8 @@ struct CutFidelity {
   double hausdorff_over_tolerance = 0;    // max over samples of distance / tolerance
   double faces_over_tolerance = 0;        // the same, faces -> sweep only
   Vec3 worst_swept_point = Vec3::Zero();  // the swept point farthest from any open face
+  Vec3 worst_face_point = Vec3::Zero();   // the open face point farthest (over tolerance)
+                                          // from the swept surface
   double wall_alignment = 0;              // area-weighted mean |n_face . n_blade|
   int open_cut_faces = 0;                 // in the region
   // min(opened_area) / swept_area (0 when nothing was swept).
