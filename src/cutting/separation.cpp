@@ -147,10 +147,69 @@ std::vector<std::pair<int, int>> planned_bad_edges(const TetMesh& mesh, const Cu
   return bad;
 }
 
+// A few tets that the marks around them would cut loose (a tet lying flat in the crease of two
+// sweep triangles, marked on every face): one of their closed marks is dropped - the piece is
+// an artefact of the discretisation, not tissue the blade severed.
+constexpr size_t kSliverPieceTets = 8;
+
+void keep_slivers_attached(TetMesh& mesh, const CutState& state,
+                           const std::vector<int>& region_tets, std::set<FaceKey>& new_faces) {
+  // Every tet of a new mark (some lie outside the region: marks in the stroke's earlier
+  // triangles) and the region's.
+  std::vector<int> seeds = region_tets;
+  for (const FaceKey& key : new_faces)
+    for (int t : state.node_tets[key[0]]) {
+      const Tet& k = mesh.tets[t];
+      if (std::find(k.begin(), k.end(), key[1]) != k.end() &&
+          std::find(k.begin(), k.end(), key[2]) != k.end())
+        seeds.push_back(t);
+    }
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  // The tets reachable from seed through unmarked interior faces, up to just over the limit.
+  auto piece_of = [&](int seed) {
+    std::vector<int> piece = {seed};
+    for (size_t i = 0; i < piece.size() && piece.size() <= kSliverPieceTets; ++i)
+      for (int f = 0; f < 4; ++f) {
+        if (mesh.is_cut_face(piece[i], f)) continue;
+        const int other = neighbour_across(mesh, state, piece[i], f).first;
+        if (other >= 0 && std::find(piece.begin(), piece.end(), other) == piece.end())
+          piece.push_back(other);
+      }
+    return piece;
+  };
+  for (int seed : seeds) {
+    for (bool dropped = true; dropped;) {
+      dropped = false;
+      const std::vector<int> piece = piece_of(seed);
+      if (piece.size() > kSliverPieceTets) break;
+      // A small closed piece: drop one closed mark, best one that joins it to a large piece,
+      // and a new one before an old.
+      int best_tet = -1, best_face = -1, best_score = -1;
+      for (int t : piece)
+        for (int f = 0; f < 4; ++f) {
+          if (!is_interior_marked(mesh, state, t, f)) continue;
+          const int other = neighbour_across(mesh, state, t, f).first;
+          if (std::find(piece.begin(), piece.end(), other) != piece.end()) continue;
+          const int score = 2 * (piece_of(other).size() > kSliverPieceTets) +
+                            (new_faces.count(face_key(mesh.tets[t], f)) > 0);
+          if (score > best_score) best_tet = t, best_face = f, best_score = score;
+        }
+      if (best_tet < 0) break;  // cut loose earlier (open walls only): nothing to undo here
+      const auto [other, other_face] = neighbour_across(mesh, state, best_tet, best_face);
+      mesh.cut_faces[best_tet] &= static_cast<std::uint8_t>(~(1u << best_face));
+      mesh.cut_faces[other] &= static_cast<std::uint8_t>(~(1u << other_face));
+      new_faces.erase(face_key(mesh.tets[best_tet], best_face));
+      dropped = true;
+    }
+  }
+}
+
 }  // namespace
 
 void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>& region_tets,
                          CutResult& result, std::set<FaceKey>& new_faces) {
+  keep_slivers_attached(mesh, state, region_tets, new_faces);
   std::vector<Duplication> plan;
   for (;;) {
     // Nodes of still-closed marked faces: only their stars can fall apart.

@@ -7,6 +7,10 @@
 // or an edge that would end up in more than two boundary triangles, gets the still-closed
 // marked faces around it unmarked and the plan is redone. Dropping closed marks only ever
 // returns towards the previous (valid) state, so the loop ends with a closed 2-manifold.
+// First, a piece of a few tets (at most 8) that the marks would cut loose - a tet lying flat in
+// the crease between two sweep triangles, marked on every face - keeps one mark closed,
+// preferably one towards a large piece: it is an artefact of the discretisation, not tissue
+// the blade severed.
 #pragma once
 
 #include "cutting/triangle_cut.hpp"
