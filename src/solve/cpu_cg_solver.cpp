@@ -145,11 +145,8 @@ class CpuCgSolver final : public LinearSolver {
       if (!chol_) return m.cwiseProduct(r);
       if (kept_.empty()) return chol_->solve(r).cwiseProduct(free_mask);
       // Factor of A_kk on the kept DOFs; Jacobi on a held DOF this solve leaves free.
-      Vector rk(static_cast<Eigen::Index>(kept_.size()));
-      for (size_t i = 0; i < kept_.size(); ++i) rk[static_cast<Eigen::Index>(i)] = r[kept_[i]];
-      const Vector zk = chol_->solve(rk);
       Vector z = m.cwiseProduct(r).cwiseProduct(held_mask_);
-      for (size_t i = 0; i < kept_.size(); ++i) z[kept_[i]] = zk[static_cast<Eigen::Index>(i)];
+      z(kept_) = chol_->solve(Vector(r(kept_)));
       return z.cwiseProduct(free_mask);
     };
 
@@ -169,18 +166,13 @@ class CpuCgSolver final : public LinearSolver {
           held_.solve(*chol_, b, held, direct);
         } else {
           const Vector rhs = b - a_ * x.cwiseProduct(held_mask_);
-          const auto k = static_cast<Eigen::Index>(kept_.size());
-          Vector bk(k), xk(k);
-          for (Eigen::Index i = 0; i < k; ++i) {
-            bk[i] = rhs[kept_[static_cast<size_t>(i)]];
-            xk[i] = x[kept_[static_cast<size_t>(i)]];
-          }
+          Vector xk = x(kept_);
           std::vector<int> held_k;  // the constrained kept DOFs, numbered in the kept block
           for (int c : held)
             if (kept_index_[static_cast<size_t>(c)] >= 0)
               held_k.push_back(kept_index_[static_cast<size_t>(c)]);
-          held_.solve(*chol_, bk, held_k, xk);
-          for (Eigen::Index i = 0; i < k; ++i) direct[kept_[static_cast<size_t>(i)]] = xk[i];
+          held_.solve(*chol_, rhs(kept_), held_k, xk);
+          direct(kept_) = xk;
         }
         result.iterations = 1;
         const double res = (b - a_ * direct).cwiseProduct(free_mask).norm() / rhs_norm;
@@ -260,9 +252,6 @@ class CpuCgSolver final : public LinearSolver {
   // The matrix to factor: A, or A_kk without the held DOFs.
   SparseMatrix factored_block() const {
     if (kept_.empty()) return a_;
-    std::vector<int> index(static_cast<size_t>(a_.rows()), -1);
-    for (size_t i = 0; i < kept_.size(); ++i)
-      index[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
     // Row by row in kept order: the renumbering is increasing, so each row's columns stay
     // sorted and the compressed arrays are written directly (no triplets, no sort).
     const auto n = static_cast<Eigen::Index>(kept_.size());
@@ -271,7 +260,7 @@ class CpuCgSolver final : public LinearSolver {
     for (Eigen::Index i = 0; i < n; ++i) {
       out.startVec(i);
       for (SparseMatrix::InnerIterator it(a_, kept_[static_cast<size_t>(i)]); it; ++it) {
-        const int j = index[static_cast<size_t>(it.index())];
+        const int j = kept_index_[static_cast<size_t>(it.index())];
         if (j >= 0) out.insertBack(i, j) = it.value();
       }
     }
