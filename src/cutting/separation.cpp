@@ -49,6 +49,14 @@ FaceKey face_key(const Tet& tet, int f) {
   return key;
 }
 
+// Unmarks closed marked face f of tet t on both of its tets.
+void unmark_face(TetMesh& mesh, const CutState& state, int t, int f, std::set<FaceKey>& new_faces) {
+  const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+  mesh.cut_faces[t] &= static_cast<std::uint8_t>(~(1u << f));
+  mesh.cut_faces[other] &= static_cast<std::uint8_t>(~(1u << other_face));
+  new_faces.erase(face_key(mesh.tets[t], f));
+}
+
 // Unmarks the still-closed marked faces that contain all of `nodes` (1 or 2 of them).
 // Returns how many faces were unmarked.
 int unmark_closed_faces(TetMesh& mesh, const CutState& state, const std::vector<int>& nodes,
@@ -61,10 +69,7 @@ int unmark_closed_faces(TetMesh& mesh, const CutState& state, const std::vector<
       bool all = true;
       for (int v : nodes) all &= std::find(key.begin(), key.end(), v) != key.end();
       if (!all) continue;
-      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
-      mesh.cut_faces[t] &= static_cast<std::uint8_t>(~(1u << f));
-      mesh.cut_faces[other] &= static_cast<std::uint8_t>(~(1u << other_face));
-      new_faces.erase(key);
+      unmark_face(mesh, state, t, f, new_faces);
       ++dropped;
     }
   }
@@ -158,11 +163,9 @@ void keep_slivers_attached(TetMesh& mesh, const CutState& state,
   // triangles) and the region's.
   std::vector<int> seeds = region_tets;
   for (const FaceKey& key : new_faces)
-    for (int t : state.node_tets[key[0]]) {
+    for (int t : tets_with_edge(state, key[0], key[1])) {
       const Tet& k = mesh.tets[t];
-      if (std::find(k.begin(), k.end(), key[1]) != k.end() &&
-          std::find(k.begin(), k.end(), key[2]) != k.end())
-        seeds.push_back(t);
+      if (std::find(k.begin(), k.end(), key[2]) != k.end()) seeds.push_back(t);
     }
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
@@ -196,10 +199,7 @@ void keep_slivers_attached(TetMesh& mesh, const CutState& state,
           if (score > best_score) best_tet = t, best_face = f, best_score = score;
         }
       if (best_tet < 0) break;  // cut loose earlier (open walls only): nothing to undo here
-      const auto [other, other_face] = neighbour_across(mesh, state, best_tet, best_face);
-      mesh.cut_faces[best_tet] &= static_cast<std::uint8_t>(~(1u << best_face));
-      mesh.cut_faces[other] &= static_cast<std::uint8_t>(~(1u << other_face));
-      new_faces.erase(face_key(mesh.tets[best_tet], best_face));
+      unmark_face(mesh, state, best_tet, best_face, new_faces);
       dropped = true;
     }
   }
