@@ -13,6 +13,9 @@ namespace {
 // The six edges of a tet as local vertex pairs.
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
+// Angles (degrees) this close are equal for the relocation's quality guard.
+constexpr double kAngleRoundOffDeg = 1e-6;
+
 struct Split {
   int a, b;  // a < b
   double t;  // crossing at x_a + t (x_b - x_a)
@@ -88,7 +91,12 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
       return false;
     after = std::min(after, smallest_dihedral(a, b, c, d));
   }
-  if (after < std::min(before, options.relocate_min_dihedral_deg)) return false;
+  // "No worse" up to round-off: a move along an edge of the star often leaves its smallest
+  // angle the same in exact arithmetic (the angle at an edge whose faces the move slides
+  // within), and the decision must not rest on the last digits of the position (the gl and
+  // cpu backends map the blade into rest coordinates ~1e-12 apart).
+  if (after < std::min(before, options.relocate_min_dihedral_deg) - kAngleRoundOffDeg)
+    return false;
   mesh.nodes[v] = target;
   for (int t : star) {
     state.grid.insert(mesh, t);  // its box may have grown
