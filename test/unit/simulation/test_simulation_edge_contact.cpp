@@ -339,20 +339,20 @@ void belly_cut_opens_the_swept_area(const TestScene& t, double opened_fraction, 
   EXPECT_GT(b.cut_steps, 10) << what;
   EXPECT_GT(b.swept, 5e-5) << what;  // > 50 mm^2: a real incision
   // The issue asks >= 90 % of the swept area; how much of a sweep opens is the cut
-  // insertion's fidelity (cutting/: only faces lying wholly on the sweep open, so a band
-  // about one operation tet wide along the cut's front stays closed, and closed cut faces
-  // wait for a later sweep). By this same measure the built-in thigh's tip stroke opens 38 %
-  // (174 of 452 mm^2). Asserted here: what the belly opens today (thigh 46 %, liver 7.8 %),
-  // so a regression in contact or yield shows; raise these with the cut-fidelity work.
+  // insertion's fidelity (cutting/, docs/DESIGN.md section 8). The liver meets it (111 %
+  // measured); the thigh's skin nodes are 8 mm apart and its operation tets ~1.3 cm, so the
+  // tets the heel's path and the stroke's end run through are cut part way and stay closed
+  // (66 % measured): asserted at what it opens today, so a regression in contact, yield or
+  // insertion shows.
   EXPECT_GE(b.opened, opened_fraction * b.swept) << what;
   EXPECT_LE(b.opened, 1.2 * b.swept) << what;  // and not beyond the sweep
 }
 
 TEST(SimulationEdgeContact, BellyCutWithTheTipOutsideOpensTheThigh) {
-  belly_cut_opens_the_swept_area(thigh(), 0.44, "thigh");
+  belly_cut_opens_the_swept_area(thigh(), 0.6, "thigh");
 }
 TEST(SimulationEdgeContact, BellyCutWithTheTipOutsideOpensTheLiver) {
-  belly_cut_opens_the_swept_area(liver(), 0.07, "liver");
+  belly_cut_opens_the_swept_area(liver(), 0.9, "liver");
 }
 
 TEST(SimulationEdgeContact, LiftingOutOrSlidingInItsOwnIncisionStopsCuttingAFreshPressCutsAgain) {
