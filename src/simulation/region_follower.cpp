@@ -99,18 +99,36 @@ std::string RegionFollower::edge_clearance(const HybridModel& model, const CutSt
 Vec3 RegionFollower::centre_for(const HybridModel& model, const CutState& cut,
                                 const std::vector<Vec3>& points, const Vec3& motion) const {
   Vec3 sum = Vec3::Zero();
-  int n = 0;
+  std::vector<Vec3> in_reach;
   for (double reach : {spacing_, spacing_ + kReach * stats_.ball.radius}) {
     for (const Vec3& p : points)
       if (near_tissue(model, cut, p, reach)) {
         sum += p;
-        ++n;
+        in_reach.push_back(p);
       }
-    if (n > 0) break;
+    if (!in_reach.empty()) break;
   }
-  Vec3 centre = n > 0 ? Vec3(sum / n) : points.front();
-  if (motion.norm() > 0) centre += kLookahead * stats_.ball.radius * motion.normalized();
-  return centre;
+  const Vec3 mean = in_reach.empty() ? points.front() : Vec3(sum / in_reach.size());
+  if (!(motion.norm() > 0)) return mean;
+  // Ahead along the motion, but no farther than keeps these points clear of the new
+  // interface (edge_clearance: reach, plus the element layer, ~2 spacings, plus a tet's
+  // extent): a ball pushed so far ahead that the blade it was placed for is not clear in it
+  // asks for the next move at once, and the region crept along a few millimetres per move
+  // (91 moves over the 9 cm liver stroke). The farthest look-ahead that keeps them clear;
+  // the whole look-ahead where no centre can (an edge deeper in the tissue than the ball
+  // holds clear: the region moves at every few millimetres whatever, and the sweeps ahead
+  // should fit).
+  const double radius = stats_.ball.radius;
+  const double clear_within = radius - (kReach * radius + 5 * spacing_);
+  const Vec3 ahead = motion.normalized();
+  auto clear_around = [&](const Vec3& centre) {
+    return std::all_of(in_reach.begin(), in_reach.end(),
+                       [&](const Vec3& p) { return (p - centre).norm() <= clear_within; });
+  };
+  if (!clear_around(mean)) return mean + kLookahead * radius * ahead;
+  for (double lookahead = kLookahead; lookahead > 0; lookahead -= 0.1)
+    if (clear_around(mean + lookahead * radius * ahead)) return mean + lookahead * radius * ahead;
+  return mean;
 }
 
 bool RegionFollower::worth_moving_to(const Vec3& centre) const {

@@ -72,7 +72,8 @@ class RegionFollower {
   std::string edge_clearance(const HybridModel& model, const CutState& cut,
                              const BladeEdge& edge) const;
   // Where the ball goes for these blade points: the mean of those within reach of tissue,
-  // pushed 0.4 R along the blade's motion (a stroke crosses fewer moves).
+  // pushed up to 0.4 R along the blade's motion (a stroke crosses fewer moves), no farther
+  // than keeps them clear of the new interface (docs/DESIGN.md section 10a).
   Vec3 centre_for(const HybridModel& model, const CutState& cut, const std::vector<Vec3>& points,
                   const Vec3& motion) const;
   std::vector<Vec3> edge_points(const BladeEdge& edge) const;
