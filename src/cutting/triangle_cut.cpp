@@ -95,8 +95,7 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
   // angle the same in exact arithmetic (the angle at an edge whose faces the move slides
   // within), and the decision must not rest on the last digits of the position (the gl and
   // cpu backends map the blade into rest coordinates ~1e-12 apart).
-  if (after < std::min(before, options.relocate_min_dihedral_deg) - kAngleRoundOffDeg)
-    return false;
+  if (after < std::min(before, options.relocate_min_dihedral_deg) - kAngleRoundOffDeg) return false;
   mesh.nodes[v] = target;
   for (int t : star) {
     state.grid.insert(mesh, t);  // its box may have grown
