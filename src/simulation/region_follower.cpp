@@ -98,17 +98,18 @@ std::string RegionFollower::edge_clearance(const HybridModel& model, const CutSt
 
 Vec3 RegionFollower::centre_for(const HybridModel& model, const CutState& cut,
                                 const std::vector<Vec3>& points, const Vec3& motion) const {
-  Vec3 sum = Vec3::Zero();
   std::vector<Vec3> in_reach;
   for (double reach : {spacing_, spacing_ + kReach * stats_.ball.radius}) {
     for (const Vec3& p : points)
-      if (near_tissue(model, cut, p, reach)) {
-        sum += p;
-        in_reach.push_back(p);
-      }
+      if (near_tissue(model, cut, p, reach)) in_reach.push_back(p);
     if (!in_reach.empty()) break;
   }
-  const Vec3 mean = in_reach.empty() ? points.front() : Vec3(sum / in_reach.size());
+  Vec3 mean = points.front();
+  if (!in_reach.empty()) {
+    mean.setZero();
+    for (const Vec3& p : in_reach) mean += p;
+    mean /= static_cast<double>(in_reach.size());
+  }
   if (!(motion.norm() > 0)) return mean;
   // Ahead along the motion, but no farther than keeps these points clear of the new
   // interface (edge_clearance: reach, plus the element layer, ~2 spacings, plus a tet's
@@ -126,8 +127,10 @@ Vec3 RegionFollower::centre_for(const HybridModel& model, const CutState& cut,
                        [&](const Vec3& p) { return (p - centre).norm() <= clear_within; });
   };
   if (!clear_around(mean)) return mean + kLookahead * radius * ahead;
-  for (double lookahead = kLookahead; lookahead > 0; lookahead -= 0.1)
-    if (clear_around(mean + lookahead * radius * ahead)) return mean + lookahead * radius * ahead;
+  for (int tenths = 4; tenths >= 1; --tenths) {  // kLookahead = 0.4 R down to 0.1 R
+    const Vec3 centre = mean + 0.1 * tenths * radius * ahead;
+    if (clear_around(centre)) return centre;
+  }
   return mean;
 }
 
