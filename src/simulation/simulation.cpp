@@ -85,6 +85,10 @@ struct Simulation::Impl {
   // next sweep of the same stroke starts from exactly this polyline (no gap, no overlap).
   std::optional<BladePose> last_cut_pose;
   std::vector<Vec3> last_rest_edge;
+  // What the blade imposed at the last step (contact): imposed again while the blade stays
+  // at that pose (a still step changes nothing, section 7). After a yield the blade holds the
+  // pressed tissue until its first motion, whose sweep is carried to rest through it.
+  ImposedDisplacements blade_imposed;
 
   bool cutting_enabled = true;
   std::uint64_t steps = 0, surface_version = 0, mesh_version = 0;
@@ -154,6 +158,7 @@ struct Simulation::Impl {
     stroke.clear();
     last_cut_pose.reset();
     last_rest_edge.clear();
+    blade_imposed.clear();
     steps = 0;
     cuts = tets_split = 0;
     cg_iterations_total = 0;
@@ -477,7 +482,10 @@ struct Simulation::Impl {
     if (contact.tip_anchor())
       for (int n : contact.tip_anchor()->nodes)
         release = release || !operation_or_interface(*model, n);
-    if (release) contact.release();
+    if (release) {
+      contact.release();
+      blade_imposed.clear();
+    }
     // Nodes of held pieces that were condensed are part 1 now: held where they are (the
     // worker built the model holding them). A piece it found free that no cut reported (none
     // expected) is held from now on too.
@@ -591,6 +599,29 @@ struct Simulation::Impl {
                           [&](const Vec3& p) { return surface_tree.contains(p); });
   }
 
+  // The cutting state's step (docs/DESIGN.md section 7): the tissue has yielded, and the edge
+  // opens it wherever it is in the tissue (the belly too, the tip may be outside). Lifted out,
+  // or sliding through its own incision (this step's sweep lies in what the stroke has swept
+  // already), it is free again; a fresh press starts a new cut.
+  void advance_stroke(const BladePose& blade, const BladeEdge& edge, StepStats& s) {
+    const double length = scene.scalpel.blade_length;
+    std::vector<BladeEdge> swept;
+    for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
+    const bool retracing =
+        last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
+    if (last_pose && !retracing) {
+      if (!follower)
+        cut(*last_pose, blade, s);
+      else
+        pending_sweeps.push_back({*last_pose, blade});
+    }
+    stroke.push_back(blade);
+    if (retracing || !edge_inside_tissue(edge)) {
+      blade_state = BladeState::kFree;
+      stroke.clear();
+    }
+  }
+
   StepStats step(const std::optional<BladePose>& blade) {
     const auto t_step = Clock::now();
     StepStats s;
@@ -604,33 +635,19 @@ struct Simulation::Impl {
     } else {
       const BladeEdge edge = blade_edge(*blade, length);
       auto t0 = Clock::now();
-      if (blade_state == BladeState::kCutting) {
-        // The tissue has yielded: the edge opens it wherever it is in the tissue (the belly
-        // too, the tip may be outside). Lifted out, or sliding through its own incision
-        // (this step's sweep lies in what the stroke has swept already), it is free again;
-        // a fresh press starts a new cut.
-        std::vector<BladeEdge> swept;
-        for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
-        const bool retracing =
-            last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
-        // A blade held still sweeps nothing. `follow`: such a sweep is not queued either: it
-        // has no motion to place the ball ahead by (centre_for), so between two moving sweeps
-        // it would pull the ball back and the next one push it ahead again, two moves per sweep
-        // (a lockstep bag replay holds every pose for a few steps: 429 moves instead of 49 on
-        // the 10 cm thigh stroke, and a backlog the online loop never caught up with).
-        const bool still = last_pose && last_pose->position == blade->position &&
-                           last_pose->orientation.coeffs() == blade->orientation.coeffs();
-        if (last_pose && !retracing) {
-          if (!follower)
-            cut(*last_pose, *blade, s);
-          else if (!still)
-            pending_sweeps.push_back({*last_pose, *blade});
-        }
-        stroke.push_back(*blade);
-        if (retracing || !edge_inside_tissue(edge)) {
-          blade_state = BladeState::kFree;
-          stroke.clear();
-        }
+      // A blade held still (the last step's pose, bit for bit) imposes what it imposed and
+      // changes no state: a step repeated at one pose is a no-op (docs/DESIGN.md section 7), so
+      // a replay ends in the same mesh however many steps each pose was held for. (A still
+      // blade used to cut again where the relaxing tissue carried its rest image, to count as
+      // retracing right after the yield, and to catch the skin it had just been lifted out of.
+      // `follow`: it would also pull the ball back between two moving sweeps.)
+      const bool still = last_pose && last_pose->position == blade->position &&
+                         last_pose->orientation.coeffs() == blade->orientation.coeffs();
+      if (still) {
+        imposed = blade_imposed;
+      } else if (blade_state == BladeState::kCutting) {
+        contact.release();  // held since the yield (blade_imposed)
+        advance_stroke(*blade, edge, s);
       } else {
         surface_tree.refit(model->mesh(), displacements());
         std::optional<BladeEdge> previous;
@@ -665,11 +682,11 @@ struct Simulation::Impl {
       s.contact_torque = w.torque;
       if (cutting_enabled && s.contact_force.norm() > scene.scalpel.cut_pressure) {
         blade_state = BladeState::kCutting;  // the tissue yields: the next motion cuts
-        contact.release();
-        stroke = {*blade};
+        stroke = {*blade};                   // `contact` lets go at its first motion
       }
     }
     last_pose = blade;
+    blade_imposed = imposed;
     if (s.cg_iterations > 0 || s.cutting || s.region_moved)
       ++surface_version;  // the drawn surface changed
     s.step_ms = ms_since(t_step);
