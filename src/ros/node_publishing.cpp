@@ -7,13 +7,15 @@ namespace stc {
 namespace ros_io {
 
 void TissueNode::publish_step_locked(const StepStats& s, const std::optional<BladePose>& blade,
-                                     const ros::Time& stamp, double rate_hz) {
+                                     std::int64_t scalpel_stamp_ns, const ros::Time& stamp,
+                                     double rate_hz) {
   // backend: what actually solved (cpu when a gl solve fell back).
   soft_tissue_cutting::SimStats stats =
       to_stats_msg(s, sim_->counts(), s.solved_by.empty() ? sim_->backend() : s.solved_by,
                    sim_->renderer(), rate_hz, last_recovery_ms_.load());
   stats.header.stamp = stamp;
   stats.header.frame_id = params_.frame_id;
+  if (blade && scalpel_stamp_ns > 0) stats.scalpel_stamp.fromNSec(scalpel_stamp_ns);
   stats_pub_.publish(stats);
   const bool blade_axes = params_.wrench_frame == "blade";
   geometry_msgs::WrenchStamped wrench = to_wrench_msg(s, blade_axes ? blade : std::nullopt);

@@ -12,22 +12,23 @@ double distance_to_box(const Box& box, const Vec3& p) {
   return outside.norm();
 }
 
-PoseDecision PoseInput::offer(const BladePose& pose) {
+PoseDecision PoseInput::offer(const BladePose& pose, std::int64_t stamp_ns) {
   PoseDecision d;
   d.why = pose_problem(pose);
   if (!d.why.empty()) return d;  // not a jump: does not count towards re-arming
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!last_) return offer_first_locked(pose, PoseVerdict::kAccepted);
+  if (!last_) return offer_first_locked(pose, stamp_ns, PoseVerdict::kAccepted);
   const double jump = (pose.position - last_->position).norm();
   if (jump <= settings_.max_jump) {
     consecutive_jumps_ = 0;
     last_ = pose;
     last_->orientation.normalize();
+    last_stamp_ns_ = stamp_ns;
     d.verdict = PoseVerdict::kAccepted;
     return d;
   }
   if (++consecutive_jumps_ >= settings_.rearm_after) {
-    d = offer_first_locked(pose, PoseVerdict::kRearmed);
+    d = offer_first_locked(pose, stamp_ns, PoseVerdict::kRearmed);
     if (d.accepted()) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
@@ -47,7 +48,8 @@ PoseDecision PoseInput::offer(const BladePose& pose) {
   return d;
 }
 
-PoseDecision PoseInput::offer_first_locked(const BladePose& pose, PoseVerdict on_success) {
+PoseDecision PoseInput::offer_first_locked(const BladePose& pose, std::int64_t stamp_ns,
+                                           PoseVerdict on_success) {
   PoseDecision d;
   const double off = distance_to_box(settings_.tissue_box, pose.position);
   if (off > settings_.max_jump) {
@@ -62,18 +64,21 @@ PoseDecision PoseInput::offer_first_locked(const BladePose& pose, PoseVerdict on
   consecutive_jumps_ = 0;
   last_ = pose;
   last_->orientation.normalize();
+  last_stamp_ns_ = stamp_ns;
   d.verdict = on_success;
   return d;
 }
 
-std::optional<BladePose> PoseInput::latest() const {
+std::optional<BladePose> PoseInput::latest(std::int64_t* stamp_ns) const {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (stamp_ns) *stamp_ns = last_ ? last_stamp_ns_ : 0;
   return last_;
 }
 
 void PoseInput::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   last_.reset();
+  last_stamp_ns_ = 0;
   consecutive_jumps_ = 0;
 }
 

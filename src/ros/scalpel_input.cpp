@@ -29,8 +29,9 @@ bool TissueNode::to_scene_frame(const geometry_msgs::PoseStamped& in, geometry_m
   }
 }
 
-void TissueNode::offer_pose(const geometry_msgs::Pose& pose, const char* source) {
-  const PoseDecision d = pose_input_.offer(to_blade_pose(pose, 0.0));
+void TissueNode::offer_pose(const geometry_msgs::Pose& pose, const ros::Time& stamp,
+                            const char* source) {
+  const PoseDecision d = pose_input_.offer(to_blade_pose(pose, 0.0), stamp.toNSec());
   if (d.verdict == PoseVerdict::kRearmed)
     ROS_WARN_THROTTLE(1.0, "tissue_node: scalpel %s: %s", source, d.why.c_str());
   else if (!d.accepted())
@@ -49,10 +50,10 @@ void TissueNode::on_pose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
     ROS_WARN_THROTTLE(1.0, "tissue_node: dropped scalpel pose: %s", why.c_str());
     return;
   }
-  offer_pose(pose, "pose");
+  offer_pose(pose, msg->header.stamp, "pose");
 }
 
-std::optional<BladePose> TissueNode::current_blade() {
+std::optional<BladePose> TissueNode::current_blade(std::int64_t* stamp_ns) {
   if (!params_.scalpel_frame.empty()) {
     try {
       const geometry_msgs::TransformStamped tf =
@@ -66,14 +67,14 @@ std::optional<BladePose> TissueNode::current_blade() {
       if (!problem.empty())
         ROS_WARN_THROTTLE(1.0, "tissue_node: dropped scalpel tf pose: %s", problem.c_str());
       else
-        offer_pose(pose, "tf pose");
+        offer_pose(pose, tf.header.stamp, "tf pose");
     } catch (const tf2::TransformException& e) {
       ROS_WARN_THROTTLE(5.0, "tissue_node: no transform %s -> %s: %s",
                         params_.scalpel_frame.c_str(), params_.frame_id.c_str(),
                         shorten(e.what()).c_str());
     }
   }
-  return pose_input_.latest();
+  return pose_input_.latest(stamp_ns);
 }
 
 }  // namespace ros_io

@@ -22,7 +22,8 @@ void TissueNode::loop() {
       // A ~cut slice first (up to ~40 % of the period, at least one sweep; see
       // advance_cut_locked), then the step that solves on the cut mesh.
       advance_cut_locked(t0 + period * 2 / 5);
-      std::optional<BladePose> blade = current_blade();
+      std::int64_t scalpel_stamp_ns = 0;
+      std::optional<BladePose> blade = current_blade(&scalpel_stamp_ns);
       if (blade) blade->t = static_cast<double>(steps_) / params_.rate;
       const StepStats s = sim_->step(blade);
       converged = s.converged;
@@ -41,7 +42,7 @@ void TissueNode::loop() {
       if (!s.fallback_reason.empty()) ROS_WARN_THROTTLE(10.0, "%s", s.fallback_reason.c_str());
       finish_cut_locked(s);
       const ros::Time stamp = ros::Time::now();
-      publish_step_locked(s, blade, stamp, monitor_.health(Clock::now()).rate_hz);
+      publish_step_locked(s, blade, scalpel_stamp_ns, stamp, monitor_.health(Clock::now()).rate_hz);
       ++steps_;
     }
     monitor_.step_finished(Clock::now(), converged);

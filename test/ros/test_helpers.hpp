@@ -44,23 +44,26 @@ inline std::vector<geometry_msgs::PoseStamped> read_scalpel_poses(const std::str
   return poses;
 }
 
-// Lockstep replay: publishes `pose` and spins until the node has stepped on it, i.e. three
-// ~stats stamped after the publish arrived in `stats` (appended by the caller's subscription;
-// the third step surely started after the pose arrived). The node's loop samples the latest
-// pose on its own clock, so a replay at the recorded pace would feed a different pose sequence
-// each time; in lockstep every replay feeds the bag's exact sequence (some poses held for a
-// few steps, which sweeps nothing). False when the node stopped stepping.
+// Lockstep replay: publishes `pose` and spins until a step has used it: a ~stats in `stats`
+// (appended by the caller's subscription) whose scalpel_stamp is the pose's stamp. The node's
+// loop samples the latest pose on its own clock, so a replay at the recorded pace would feed a
+// different pose sequence each time (a pose that arrived with the next one is never stepped on);
+// in lockstep every replay feeds the bag's exact sequence, each pose held for one step or more,
+// which the simulation makes no difference (a still blade changes nothing). Counting steps
+// stamped after the publish does not prove the pose arrived: on a loaded machine its delivery
+// can outlast several steps. The poses' stamps must be distinct and non-zero. False when no step
+// used the pose within `timeout` (the node stopped stepping, or dropped the pose).
 inline bool publish_in_lockstep(const ros::Publisher& pub, const geometry_msgs::PoseStamped& pose,
                                 const std::vector<soft_tissue_cutting::SimStats>& stats,
                                 double timeout = 5.0) {
-  const ros::Time sent = ros::Time::now();
-  pub.publish(pose);  // original (old) stamps: never a reason to drop
+  if (pose.header.stamp.isZero()) return false;
   const size_t seen = stats.size();
+  pub.publish(pose);  // original (old) stamps: never a reason to drop
   return spin_until(
       [&] {
-        int after = 0;
-        for (size_t k = seen; k < stats.size(); ++k) after += stats[k].header.stamp > sent;
-        return after >= 3;
+        for (size_t k = seen; k < stats.size(); ++k)
+          if (stats[k].scalpel_stamp == pose.header.stamp) return true;
+        return false;
       },
       timeout);
 }

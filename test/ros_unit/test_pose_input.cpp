@@ -1,5 +1,6 @@
 // The pose gate without a master: NaN/zero-quaternion refusal, jumps, the first pose near the
-// tissue's bounding box, re-arming after N consecutive jumps, clear().
+// tissue's bounding box, re-arming after N consecutive jumps, clear(), the accepted pose's stamp
+// (~stats scalpel_stamp).
 #include "soft_tissue_cutting/ros/pose_input.hpp"
 
 #include <gtest/gtest.h>
@@ -104,6 +105,32 @@ TEST(PoseInput, ClearMakesTheNextPoseAFirstPose) {
   EXPECT_FALSE(gate.latest());
   EXPECT_FALSE(gate.offer(at(0.5, 0, 0.05)).accepted());  // far: refused as a first pose
   EXPECT_TRUE(gate.offer(at(0.05, 0.05, 0.05)).accepted());
+}
+
+// The stamp travels with the accepted pose: a refused pose leaves the last accepted one's, a
+// re-armed pose brings its own, clear() forgets it.
+TEST(PoseInput, TheStampOfTheAcceptedPose) {
+  PoseInput gate(settings());
+  std::int64_t stamp = -1;
+  EXPECT_FALSE(gate.latest(&stamp));
+  EXPECT_EQ(stamp, 0);
+  ASSERT_TRUE(gate.offer(at(0, 0, 0.05), 1000).accepted());
+  ASSERT_TRUE(gate.latest(&stamp));
+  EXPECT_EQ(stamp, 1000);
+  ASSERT_TRUE(gate.offer(at(0.01, 0, 0.05), 2000).accepted());
+  gate.latest(&stamp);
+  EXPECT_EQ(stamp, 2000);
+  EXPECT_FALSE(gate.offer(at(0.3, 0, 0.05), 3000).accepted());  // a jump: refused
+  gate.latest(&stamp);
+  EXPECT_EQ(stamp, 2000);
+  // Jumps 2 to 4 of rearm_after = 5 refused, the fifth re-arms on its own pose and stamp.
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(gate.offer(at(-0.05, 0, 0.05), 4000 + i).accepted());
+  EXPECT_EQ(gate.offer(at(-0.05, 0, 0.05), 4003).verdict, PoseVerdict::kRearmed);
+  gate.latest(&stamp);
+  EXPECT_EQ(stamp, 4003);
+  gate.clear();
+  EXPECT_FALSE(gate.latest(&stamp));
+  EXPECT_EQ(stamp, 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "soft_tissue_cutting/scene/scene.hpp"
 
+#include <cstdint>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -40,20 +41,25 @@ class PoseInput {
  public:
   explicit PoseInput(PoseGateSettings settings) : settings_(std::move(settings)) {}
 
-  PoseDecision offer(const BladePose& pose);
+  // `stamp_ns`: the pose's stamp (a PoseStamped's header, a tf transform's), nanoseconds; it
+  // travels with the accepted pose so ~stats can say which pose a step used.
+  PoseDecision offer(const BladePose& pose, std::int64_t stamp_ns = 0);
   // The last accepted pose, if any.
-  std::optional<BladePose> latest() const;
+  // `stamp_ns` (if given): its stamp, read under the same lock (0 if none).
+  std::optional<BladePose> latest(std::int64_t* stamp_ns = nullptr) const;
   // Forget the last accepted pose (after ~reset): the next pose is a first pose again.
   void clear();
   const PoseGateSettings& settings() const { return settings_; }
 
  private:
   // Accepts `pose` as a first pose unless it is far from the tissue. Caller holds mutex_.
-  PoseDecision offer_first_locked(const BladePose& pose, PoseVerdict on_success);
+  PoseDecision offer_first_locked(const BladePose& pose, std::int64_t stamp_ns,
+                                  PoseVerdict on_success);
 
   mutable std::mutex mutex_;
   const PoseGateSettings settings_;
   std::optional<BladePose> last_;
+  std::int64_t last_stamp_ns_ = 0;
   int consecutive_jumps_ = 0;
 };
 

@@ -85,11 +85,12 @@ class TissueNode {
   PoseGateSettings pose_gate_settings() const;
 
   // scalpel input (scalpel_input.cpp)
-  std::optional<BladePose> current_blade();  // topic or tf2 input, gated
+  // Topic or tf2 input, gated; `stamp_ns`: the pose's stamp (~stats scalpel_stamp).
+  std::optional<BladePose> current_blade(std::int64_t* stamp_ns);
   bool to_scene_frame(const geometry_msgs::PoseStamped& in, geometry_msgs::Pose* out,
                       std::string* why) const;
   void on_pose(const geometry_msgs::PoseStamped::ConstPtr& msg);
-  void offer_pose(const geometry_msgs::Pose& pose, const char* source);
+  void offer_pose(const geometry_msgs::Pose& pose, const ros::Time& stamp, const char* source);
 
   // the loop (simulation_loop.cpp)
   void loop();
@@ -98,8 +99,9 @@ class TissueNode {
   void answer_cuts(std::deque<std::shared_ptr<CutJob>> jobs, const std::string& why);
 
   // publishing (node_publishing.cpp). Callers hold sim_mutex_.
+  // `scalpel_stamp_ns`: the stamp of the pose `blade` came from (0: none).
   void publish_step_locked(const StepStats& s, const std::optional<BladePose>& blade,
-                           const ros::Time& stamp, double rate_hz);
+                           std::int64_t scalpel_stamp_ns, const ros::Time& stamp, double rate_hz);
   // The last non-converged solve's reason, for /diagnostics (under info_mutex_).
   void remember_solver_failure(const std::string& why);
 
