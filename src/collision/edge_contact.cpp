@@ -210,13 +210,17 @@ double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEd
     before.push_back({a.tip, a.heel, b.heel});
     before.push_back({a.tip, b.heel, b.tip});
   }
-  const double reach = tolerance * (from.heel - from.tip).norm();
+  const double length = (from.heel - from.tip).norm(), reach = tolerance * length;
   // Interior sample points of each triangle (barycentric grid), weighted by its area.
   constexpr int kGrid = 6;
   double covered = 0, total = 0;
   for (const auto& t : now) {
     const double area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
-    if (area <= 0) continue;
+    // A triangle narrower than `reach` across the edge (a blade held still, or moved along its
+    // own edge: a plunge) sweeps nothing, whatever its last digits: else such a move measured
+    // 0 when its area came out exactly 0 and 1 (wholly within reach of the last sweep) when
+    // rounding left 1e-17, and a 1e-16 change of the poses freed the blade or not.
+    if (area <= 0.5 * reach * length) continue;
     int in = 0, n = 0;
     for (int i = 0; i < kGrid; ++i)
       for (int j = 0; i + j < kGrid; ++j, ++n) {

@@ -110,9 +110,10 @@ bool edge_in_tissue(const BladeEdge& edge, double spacing, Inside inside) {
 double sweep_area(const BladeEdge& from, const BladeEdge& to);
 
 // How much of the sweep from `from` to `to` lies in the sweeps between consecutive edges of
-// `stroke` (0..1, by area; 0 for a sweep of no area): 1 when the blade moves back through
-// the incision it has just cut. Points count as covered within `tolerance` x the blade
-// length of an earlier sweep triangle.
+// `stroke` (0..1, by area; 0 for a sweep narrower than `tolerance` x the blade length across
+// the edge, which sweeps nothing: a blade held still or moved along its own edge): 1 when the
+// blade moves back through the incision it has just cut. Points count as covered within
+// `tolerance` x the blade length of an earlier sweep triangle.
 double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEdge& from,
                              const BladeEdge& to, double tolerance = 1e-4);
 

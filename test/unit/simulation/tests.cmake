@@ -8,7 +8,7 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/simulation/test_simulation.cpp
   test/unit/simulation/test_simulation_edge_contact.cpp
   test/unit/simulation/test_simulation_random_cuts.cpp
-  test/unit/simulation/test_simulation_still_blade.cpp
+  test/unit/simulation/test_simulation_replay.cpp
   test/unit/simulation/test_step_times.cpp
   test/unit/simulation/test_surface_snapshot.cpp
 )
