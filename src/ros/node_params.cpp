@@ -19,6 +19,7 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("backend", backend, backend);
   pnh.param<double>("max_pose_jump", p.max_pose_jump, p.max_pose_jump);
   pnh.param<int>("pose_rearm_count", p.pose_rearm_count, p.pose_rearm_count);
+  pnh.param<bool>("every_pose", p.every_pose, p.every_pose);
   pnh.param<double>("display_rate", p.display_rate, p.display_rate);
   pnh.param<int>("max_cut_poses", p.max_cut_poses, p.max_cut_poses);
   pnh.param<double>("max_cut_length", p.max_cut_length, p.max_cut_length);

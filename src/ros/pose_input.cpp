@@ -18,12 +18,9 @@ PoseDecision PoseInput::offer(const BladePose& pose, std::int64_t stamp_ns) {
   if (!d.why.empty()) return d;  // not a jump: does not count towards re-arming
   std::lock_guard<std::mutex> lock(mutex_);
   if (!last_) return offer_first_locked(pose, stamp_ns, PoseVerdict::kAccepted);
-  const double jump = (pose.position - last_->position).norm();
+  const double jump = (pose.position - last_->pose.position).norm();
   if (jump <= settings_.max_jump) {
-    consecutive_jumps_ = 0;
-    last_ = pose;
-    last_->orientation.normalize();
-    last_stamp_ns_ = stamp_ns;
+    accept_locked(pose, stamp_ns);
     d.verdict = PoseVerdict::kAccepted;
     return d;
   }
@@ -61,24 +58,55 @@ PoseDecision PoseInput::offer_first_locked(const BladePose& pose, std::int64_t s
     d.why = buf;
     return d;
   }
-  consecutive_jumps_ = 0;
-  last_ = pose;
-  last_->orientation.normalize();
-  last_stamp_ns_ = stamp_ns;
+  accept_locked(pose, stamp_ns);
   d.verdict = on_success;
   return d;
 }
 
-std::optional<BladePose> PoseInput::latest(std::int64_t* stamp_ns) const {
+void PoseInput::accept_locked(const BladePose& pose, std::int64_t stamp_ns) {
+  consecutive_jumps_ = 0;
+  last_ = Stamped{pose, stamp_ns};
+  last_->pose.orientation.normalize();
+  if (settings_.queue_limit == 0) return;
+  waiting_.push_back(*last_);
+  if (waiting_.size() > settings_.queue_limit) {
+    waiting_.pop_front();
+    ++dropped_;
+  }
+}
+
+std::optional<BladePose> PoseInput::next(std::int64_t* stamp_ns) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (stamp_ns) *stamp_ns = last_ ? last_stamp_ns_ : 0;
-  return last_;
+  const std::optional<Stamped>* current = &last_;
+  if (settings_.queue_limit > 0) {
+    if (!waiting_.empty()) {
+      served_ = waiting_.front();
+      waiting_.pop_front();
+    }
+    current = &served_;
+  }
+  if (stamp_ns) *stamp_ns = *current ? (*current)->stamp_ns : 0;
+  if (!*current) return std::nullopt;
+  return (*current)->pose;
+}
+
+std::optional<BladePose> PoseInput::latest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::optional<Stamped>& current = settings_.queue_limit > 0 ? served_ : last_;
+  if (!current) return std::nullopt;
+  return current->pose;
+}
+
+std::uint64_t PoseInput::dropped() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dropped_;
 }
 
 void PoseInput::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   last_.reset();
-  last_stamp_ns_ = 0;
+  served_.reset();
+  waiting_.clear();
   consecutive_jumps_ = 0;
 }
 

@@ -74,7 +74,7 @@ std::optional<BladePose> TissueNode::current_blade(std::int64_t* stamp_ns) {
                         shorten(e.what()).c_str());
     }
   }
-  return pose_input_.latest(stamp_ns);
+  return pose_input_.next(stamp_ns);
 }
 
 }  // namespace ros_io

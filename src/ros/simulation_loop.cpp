@@ -24,6 +24,13 @@ void TissueNode::loop() {
       advance_cut_locked(t0 + period * 2 / 5);
       std::int64_t scalpel_stamp_ns = 0;
       std::optional<BladePose> blade = current_blade(&scalpel_stamp_ns);
+      if (const std::uint64_t dropped = pose_input_.dropped(); dropped != poses_dropped_seen_) {
+        ROS_WARN_THROTTLE(2.0,
+                          "~every_pose: %llu scalpel poses dropped so far (more than %zu waited: "
+                          "they arrive faster than ~rate steps them)",
+                          static_cast<unsigned long long>(dropped), kEveryPoseQueue);
+        poses_dropped_seen_ = dropped;
+      }
       if (blade) blade->t = static_cast<double>(steps_) / params_.rate;
       const StepStats s = sim_->step(blade);
       converged = s.converged;

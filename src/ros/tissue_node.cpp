@@ -63,8 +63,11 @@ TissueNode::TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams param
 
   publish_trajectory_param();
 
+  // ~every_pose: a burst of poses waits in the gate's queue, not in a short subscriber queue
+  // that would drop the oldest.
   if (params_.scalpel_frame.empty())
-    pose_sub_ = nh_.subscribe("scalpel/pose", 10, &TissueNode::on_pose, this);
+    pose_sub_ =
+        nh_.subscribe("scalpel/pose", params_.every_pose ? 1000 : 10, &TissueNode::on_pose, this);
   else
     ROS_INFO("tissue_node: scalpel pose from tf2 frame '%s' in '%s'", params_.scalpel_frame.c_str(),
              params_.frame_id.c_str());
@@ -76,6 +79,7 @@ PoseGateSettings TissueNode::pose_gate_settings() const {
   PoseGateSettings s;
   s.max_jump = params_.max_pose_jump;
   s.rearm_after = params_.pose_rearm_count;
+  if (params_.every_pose) s.queue_limit = kEveryPoseQueue;
   const std::vector<Vec3>& x = initial_scene_.mesh.nodes;
   s.tissue_box.min = s.tissue_box.max = x.empty() ? Vec3::Zero() : x.front();
   for (const Vec3& p : x) {

@@ -1,6 +1,6 @@
 // The pose gate without a master: NaN/zero-quaternion refusal, jumps, the first pose near the
 // tissue's bounding box, re-arming after N consecutive jumps, clear(), the accepted pose's stamp
-// (~stats scalpel_stamp).
+// (~stats scalpel_stamp), ~every_pose's queue.
 #include "soft_tissue_cutting/ros/pose_input.hpp"
 
 #include <gtest/gtest.h>
@@ -112,25 +112,73 @@ TEST(PoseInput, ClearMakesTheNextPoseAFirstPose) {
 TEST(PoseInput, TheStampOfTheAcceptedPose) {
   PoseInput gate(settings());
   std::int64_t stamp = -1;
-  EXPECT_FALSE(gate.latest(&stamp));
+  EXPECT_FALSE(gate.next(&stamp));
   EXPECT_EQ(stamp, 0);
   ASSERT_TRUE(gate.offer(at(0, 0, 0.05), 1000).accepted());
-  ASSERT_TRUE(gate.latest(&stamp));
+  ASSERT_TRUE(gate.next(&stamp));
   EXPECT_EQ(stamp, 1000);
   ASSERT_TRUE(gate.offer(at(0.01, 0, 0.05), 2000).accepted());
-  gate.latest(&stamp);
+  gate.next(&stamp);
   EXPECT_EQ(stamp, 2000);
   EXPECT_FALSE(gate.offer(at(0.3, 0, 0.05), 3000).accepted());  // a jump: refused
-  gate.latest(&stamp);
+  gate.next(&stamp);
   EXPECT_EQ(stamp, 2000);
   // Jumps 2 to 4 of rearm_after = 5 refused, the fifth re-arms on its own pose and stamp.
   for (int i = 0; i < 3; ++i) EXPECT_FALSE(gate.offer(at(-0.05, 0, 0.05), 4000 + i).accepted());
   EXPECT_EQ(gate.offer(at(-0.05, 0, 0.05), 4003).verdict, PoseVerdict::kRearmed);
-  gate.latest(&stamp);
+  gate.next(&stamp);
   EXPECT_EQ(stamp, 4003);
   gate.clear();
-  EXPECT_FALSE(gate.latest(&stamp));
+  EXPECT_FALSE(gate.next(&stamp));
   EXPECT_EQ(stamp, 0);
+}
+
+// ~every_pose (queue_limit > 0): every accepted pose is handed to the loop once, in order; a
+// refused one never; the last one taken stays the blade until the next arrives; a full queue
+// drops its oldest and counts it; clear() empties it.
+TEST(PoseInput, EveryPoseInOrder) {
+  PoseGateSettings settings3 = settings();
+  settings3.queue_limit = 3;
+  PoseInput gate(settings3);
+  std::int64_t stamp = 0;
+  EXPECT_FALSE(gate.next(&stamp));
+  ASSERT_TRUE(gate.offer(at(0.00, 0, 0.05), 1).accepted());
+  ASSERT_TRUE(gate.offer(at(0.01, 0, 0.05), 2).accepted());
+  EXPECT_FALSE(gate.offer(at(0.30, 0, 0.05), 9).accepted());  // a jump: never stepped on
+  ASSERT_TRUE(gate.offer(at(0.02, 0, 0.05), 3).accepted());
+  for (std::int64_t want : {1, 2, 3, 3, 3}) {
+    const auto p = gate.next(&stamp);
+    ASSERT_TRUE(p);
+    EXPECT_EQ(stamp, want);
+    EXPECT_DOUBLE_EQ(p->position.x(), 0.01 * static_cast<double>(want - 1));
+    EXPECT_EQ(gate.latest()->position, p->position);  // the display shows what is stepped on
+  }
+  EXPECT_EQ(gate.dropped(), 0u);
+  for (int k = 4; k <= 8; ++k) ASSERT_TRUE(gate.offer(at(0.005 * k, 0, 0.05), k).accepted());
+  EXPECT_EQ(gate.dropped(), 2u);                 // 4 and 5: the queue holds 3
+  EXPECT_EQ(gate.latest()->position.x(), 0.02);  // nothing taken since
+  for (std::int64_t want : {6, 7, 8}) {
+    gate.next(&stamp);
+    EXPECT_EQ(stamp, want);
+  }
+  ASSERT_TRUE(gate.offer(at(0.045, 0, 0.05), 10).accepted());
+  gate.clear();
+  EXPECT_FALSE(gate.next(&stamp));
+  EXPECT_EQ(stamp, 0);
+  EXPECT_FALSE(gate.latest());
+}
+
+// Without a queue the loop steps on the newest pose: one overtaken before a step is skipped.
+TEST(PoseInput, NewestPoseWithoutAQueue) {
+  PoseInput gate(settings());
+  std::int64_t stamp = 0;
+  ASSERT_TRUE(gate.offer(at(0.00, 0, 0.05), 1).accepted());
+  ASSERT_TRUE(gate.offer(at(0.01, 0, 0.05), 2).accepted());
+  gate.next(&stamp);
+  EXPECT_EQ(stamp, 2);
+  gate.next(&stamp);
+  EXPECT_EQ(stamp, 2);
+  EXPECT_EQ(gate.dropped(), 0u);
 }
 
 }  // namespace

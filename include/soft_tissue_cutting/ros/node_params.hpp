@@ -19,7 +19,10 @@ struct NodeParams {
   std::optional<Backend> backend;  // ~backend; nullopt: the scene's solver.backend
   double max_pose_jump = 0.05;     // m
   int pose_rearm_count = 20;       // consecutive jump refusals before re-arming on the newest pose
-  double display_rate = 30.0;      // Hz, upper limit for ~surface / ~markers
+  // Step on every scalpel/pose in order, one per step (pose_input.hpp, queue_limit), instead
+  // of the newest: a replayed bag cuts the same at any pace the loop keeps up with.
+  bool every_pose = false;
+  double display_rate = 30.0;  // Hz, upper limit for ~surface / ~markers
   // ~cut request limits: more poses, or a longer blade travel, is refused with a message.
   int max_cut_poses = 20000;
   double max_cut_length = 1.0;  // m of blade travel (cutting/blade_path)

@@ -6,6 +6,7 @@
 #include "soft_tissue_cutting/scene/scene.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -23,6 +24,11 @@ struct PoseGateSettings {
   // first pose (~pose_rearm_count). A real scalpel that moved while its poses were lost (or
   // after one bad accepted pose) is followed again instead of being refused forever.
   int rearm_after = 20;
+  // 0: the loop steps on the newest accepted pose (a pose overtaken by the next before a step
+  // is never stepped on). N > 0 (~every_pose): on every accepted pose in order, one per step, at
+  // most N waiting (beyond that the oldest is dropped and counted): a replayed bag then cuts
+  // the same at any pace the loop keeps up with.
+  size_t queue_limit = 0;
 };
 
 enum class PoseVerdict {
@@ -44,10 +50,17 @@ class PoseInput {
   // `stamp_ns`: the pose's stamp (a PoseStamped's header, a tf transform's), nanoseconds; it
   // travels with the accepted pose so ~stats can say which pose a step used.
   PoseDecision offer(const BladePose& pose, std::int64_t stamp_ns = 0);
-  // The last accepted pose, if any.
-  // `stamp_ns` (if given): its stamp, read under the same lock (0 if none).
-  std::optional<BladePose> latest(std::int64_t* stamp_ns = nullptr) const;
-  // Forget the last accepted pose (after ~reset): the next pose is a first pose again.
+  // The pose the loop steps on next: the newest accepted one, or (queue_limit > 0) the oldest
+  // waiting one, taken off the queue, else the last one taken. `stamp_ns` (if given): its
+  // stamp, read under the same lock (0 if none).
+  std::optional<BladePose> next(std::int64_t* stamp_ns = nullptr);
+  // What the loop steps on now, for display: the newest accepted pose, or (queue_limit > 0)
+  // the last one next() took.
+  std::optional<BladePose> latest() const;
+  // Poses dropped from a full queue since the start.
+  std::uint64_t dropped() const;
+  // Forget the last accepted pose and every waiting one (after ~reset): the next pose is a
+  // first pose again.
   void clear();
   const PoseGateSettings& settings() const { return settings_; }
 
@@ -55,11 +68,18 @@ class PoseInput {
   // Accepts `pose` as a first pose unless it is far from the tissue. Caller holds mutex_.
   PoseDecision offer_first_locked(const BladePose& pose, std::int64_t stamp_ns,
                                   PoseVerdict on_success);
+  void accept_locked(const BladePose& pose, std::int64_t stamp_ns);
 
+  struct Stamped {
+    BladePose pose;
+    std::int64_t stamp_ns = 0;
+  };
   mutable std::mutex mutex_;
   const PoseGateSettings settings_;
-  std::optional<BladePose> last_;
-  std::int64_t last_stamp_ns_ = 0;
+  std::optional<Stamped> last_;    // the last accepted pose: jumps are measured from it
+  std::deque<Stamped> waiting_;    // queue_limit > 0: accepted, not yet stepped on
+  std::optional<Stamped> served_;  // queue_limit > 0: the last pose next() took
+  std::uint64_t dropped_ = 0;
   int consecutive_jumps_ = 0;
 };
 

@@ -57,6 +57,10 @@
 namespace stc {
 namespace ros_io {
 
+// ~every_pose: at most this many accepted poses wait for a step (100 s at 100 Hz); beyond it
+// the oldest is dropped with a throttled warning.
+constexpr size_t kEveryPoseQueue = 10000;
+
 class TissueNode {
  public:
   TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams params, Scene scene,
@@ -190,6 +194,7 @@ class TissueNode {
   std::string solved_by_, fallback_reason_;      // the last step's (cpu when a gl solve fell back)
   std::optional<RegionMoveStats> region_moves_;  // `follow` region: as of the last step
   std::uint64_t steps_ = 0;                      // loop thread
+  std::uint64_t poses_dropped_seen_ = 0;         // loop thread: pose_input_.dropped() last warned
 
   // surface versions restart with each fresh Simulation: ~reset bumps it (under sim_mutex_).
   std::uint64_t sim_generation_ = 0;
