@@ -9,22 +9,64 @@
 namespace stc {
 namespace ros_io {
 
+namespace {
+
+// ~key into `value` if set; a value of the wrong type is an error naming the key (ros::param
+// would silently keep the default: `_rate:=fast` ran at 100 Hz). An int is a double too.
+template <typename T>
+void read(const ros::NodeHandle& pnh, const char* key, T& value, const char* type) {
+  if (!pnh.hasParam(key)) return;
+  if (!pnh.getParam(key, value))
+    throw std::runtime_error(std::string("~") + key + " must be " + type);
+}
+
+// ros::param rounds a double into an int (`_max_cut_poses:=1.5` ran with 2): only an integer
+// value is an integer here.
+template <>
+void read<int>(const ros::NodeHandle& pnh, const char* key, int& value, const char* type) {
+  if (!pnh.hasParam(key)) return;
+  XmlRpc::XmlRpcValue v;
+  if (pnh.getParam(key, v)) {
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      value = static_cast<int>(v);
+      return;
+    }
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      const double d = static_cast<double>(v);
+      if (std::isfinite(d) && d == std::floor(d) && std::abs(d) < 2e9) {
+        value = static_cast<int>(d);
+        return;
+      }
+    }
+  }
+  throw std::runtime_error(std::string("~") + key + " must be " + type);
+}
+
+}  // namespace
+
 NodeParams read_params(const ros::NodeHandle& pnh) {
   NodeParams p;
-  pnh.param<std::string>("scene", p.scene, p.scene);
-  pnh.param<std::string>("frame_id", p.frame_id, p.frame_id);
-  pnh.param<double>("rate", p.rate, p.rate);
-  pnh.param<std::string>("scalpel_frame", p.scalpel_frame, p.scalpel_frame);
+  read(pnh, "scene", p.scene, "a string (a scene YAML path or thigh)");
+  read(pnh, "frame_id", p.frame_id, "a string (a tf frame)");
+  read(pnh, "rate", p.rate, "a number (steps per second)");
+  read(pnh, "scalpel_frame", p.scalpel_frame, "a string (a tf frame)");
   std::string backend;  // empty: the scene's
-  pnh.param<std::string>("backend", backend, backend);
-  pnh.param<double>("max_pose_jump", p.max_pose_jump, p.max_pose_jump);
-  pnh.param<int>("pose_rearm_count", p.pose_rearm_count, p.pose_rearm_count);
-  pnh.param<bool>("every_pose", p.every_pose, p.every_pose);
-  pnh.param<double>("display_rate", p.display_rate, p.display_rate);
-  pnh.param<int>("max_cut_poses", p.max_cut_poses, p.max_cut_poses);
-  pnh.param<double>("max_cut_length", p.max_cut_length, p.max_cut_length);
-  pnh.param<std::string>("parent_frame", p.parent_frame, p.parent_frame);
-  pnh.param<std::string>("wrench_frame", p.wrench_frame, p.wrench_frame);
+  read(pnh, "backend", backend, "a string (cpu or gl)");
+  read(pnh, "max_pose_jump", p.max_pose_jump, "a number (m)");
+  read(pnh, "pose_rearm_count", p.pose_rearm_count, "an integer");
+  read(pnh, "every_pose", p.every_pose, "true or false");
+  read(pnh, "display_rate", p.display_rate, "a number (Hz)");
+  read(pnh, "max_cut_poses", p.max_cut_poses, "an integer");
+  read(pnh, "max_cut_length", p.max_cut_length, "a number (m)");
+  read(pnh, "parent_frame", p.parent_frame, "a string (a tf frame)");
+  read(pnh, "wrench_frame", p.wrench_frame, "a string (tissue or blade)");
+  {  // dynamic_reconfigure's start values (tissue_node.cpp reads them): the type only here
+    double number = 0;
+    bool flag = false;
+    read(pnh, "cut_pressure", number, "a number (N)");
+    read(pnh, "young_modulus", number, "a number (Pa)");
+    read(pnh, "cutting_enabled", flag, "true or false");
+  }
   if (p.wrench_frame != "tissue" && p.wrench_frame != "blade")
     throw std::runtime_error("~wrench_frame must be tissue or blade, not '" +
                              shorten(p.wrench_frame) + "'");
