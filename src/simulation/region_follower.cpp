@@ -135,7 +135,11 @@ Vec3 RegionFollower::centre_for(const HybridModel& model, const CutState& cut,
 }
 
 bool RegionFollower::worth_moving_to(const Vec3& centre) const {
-  return (centre - stats_.ball.center).norm() > kMinShift * stats_.ball.radius;
+  // A shift equal to the threshold up to rounding counts as equal (not worth it): a trajectory
+  // advancing exactly 0.1 R per pose (thigh_follow: 2.5 mm, R = 2.5 cm) otherwise moved or not
+  // by the last digits of the poses, and the cut with it (docs/DESIGN.md section 10a).
+  constexpr double kRoundOff = 1e-9;
+  return (centre - stats_.ball.center).norm() > kMinShift * stats_.ball.radius * (1 + kRoundOff);
 }
 
 void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,

@@ -142,5 +142,12 @@ TEST(SimulationReplay, RoundingOfThePosesDecidesNothingOnTheTetGenLiver) {
   rounding_decides_nothing(load_scene(scene_path("liver_cut.yaml")), "liver_cut");
 }
 
+// thigh_follow's stroke advances exactly 0.1 R per pose, the follow region's smallest move:
+// whether the region moved (and so the cut, which waits at the interface for a move) was
+// decided by the poses' last digits (region_follower.cpp, worth_moving_to).
+TEST(SimulationReplay, RoundingOfThePosesDecidesNothingWithAMovingRegion) {
+  rounding_decides_nothing(load_scene(scene_path("thigh_follow.yaml")), "thigh_follow");
+}
+
 }  // namespace
 }  // namespace stc
