@@ -15,7 +15,7 @@ void TissueNode::publish_step_locked(const StepStats& s, const std::optional<Bla
                    sim_->renderer(), rate_hz, last_recovery_ms_.load());
   stats.header.stamp = stamp;
   stats.header.frame_id = params_.frame_id;
-  if (blade && scalpel_stamp_ns > 0) stats.scalpel_stamp.fromNSec(scalpel_stamp_ns);
+  if (scalpel_stamp_ns > 0) stats.scalpel_stamp.fromNSec(scalpel_stamp_ns);
   stats_pub_.publish(stats);
   const bool blade_axes = params_.wrench_frame == "blade";
   geometry_msgs::WrenchStamped wrench = to_wrench_msg(s, blade_axes ? blade : std::nullopt);

@@ -77,22 +77,19 @@ void PoseInput::accept_locked(const BladePose& pose, std::int64_t stamp_ns) {
 
 std::optional<BladePose> PoseInput::next(std::int64_t* stamp_ns) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const std::optional<Stamped>* current = &last_;
-  if (settings_.queue_limit > 0) {
-    if (!waiting_.empty()) {
-      served_ = waiting_.front();
-      waiting_.pop_front();
-    }
-    current = &served_;
+  if (settings_.queue_limit > 0 && !waiting_.empty()) {
+    served_ = waiting_.front();
+    waiting_.pop_front();
   }
-  if (stamp_ns) *stamp_ns = *current ? (*current)->stamp_ns : 0;
-  if (!*current) return std::nullopt;
-  return (*current)->pose;
+  const auto& current = current_locked();
+  if (stamp_ns) *stamp_ns = current ? current->stamp_ns : 0;
+  if (!current) return std::nullopt;
+  return current->pose;
 }
 
 std::optional<BladePose> PoseInput::latest() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const std::optional<Stamped>& current = settings_.queue_limit > 0 ? served_ : last_;
+  const auto& current = current_locked();
   if (!current) return std::nullopt;
   return current->pose;
 }

@@ -686,7 +686,7 @@ struct Simulation::Impl {
       }
     }
     last_pose = blade;
-    blade_imposed = imposed;
+    blade_imposed = std::move(imposed);  // not read below
     if (s.cg_iterations > 0 || s.cutting || s.region_moved)
       ++surface_version;  // the drawn surface changed
     s.step_ms = ms_since(t_step);

@@ -8,6 +8,7 @@
 #include "test_helpers.hpp"
 
 #include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/ros/conversions.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -25,16 +26,10 @@ using tissue_test::spin_until;
 
 namespace {
 
-// The core's cut of the same poses, one step each.
+// The core's cut of the same poses, one step each, converted as the node converts them.
 std::string core_hash(const std::vector<geometry_msgs::PoseStamped>& poses) {
   stc::Simulation sim(stc::make_thigh_scene());
-  for (const auto& p : poses) {
-    stc::BladePose b;
-    b.position = stc::Vec3(p.pose.position.x, p.pose.position.y, p.pose.position.z);
-    b.orientation = Eigen::Quaterniond(p.pose.orientation.w, p.pose.orientation.x,
-                                       p.pose.orientation.y, p.pose.orientation.z);
-    sim.step(b);
-  }
+  for (const auto& p : poses) sim.step(stc::ros_io::to_blade_pose(p.pose, 0.0));
   return sim.mesh_hash();
 }
 
@@ -90,12 +85,7 @@ TEST(BagReplayPaced, EveryPoseIsSteppedOnAtAnyPace) {
       previous = s.scalpel_stamp;
     }
     size_t stepped = 0;
-    for (const auto& p : poses)
-      for (const auto& s : stats)
-        if (s.scalpel_stamp == p.header.stamp) {
-          ++stepped;
-          break;
-        }
+    for (const auto& p : poses) stepped += tissue_test::stepped_on(stats, 0, p.header.stamp);
     std::printf(
         "[bag_replay_paced] speed %.0fx: %zu poses over %.2f s, %zu steps, %zu poses "
         "stepped on; cuts %u, tets %u; hash %s (core %s)\n",

@@ -48,13 +48,6 @@ geometry_msgs::TransformStamped placed(const std::string& parent, const std::str
   return m;
 }
 
-bool acked(const std::vector<soft_tissue_cutting::SimStats>& stats, size_t from,
-           const ros::Time& stamp) {
-  for (size_t k = from; k < stats.size(); ++k)
-    if (stats[k].scalpel_stamp == stamp) return true;
-  return false;
-}
-
 TEST(TfScalpel, ARobotsToolFrameCutsLikeTheTopic) {
   ros::NodeHandle nh;
   std::string path;
@@ -119,11 +112,13 @@ TEST(TfScalpel, ARobotsToolFrameCutsLikeTheTopic) {
     pose_pub.publish(p);
     ASSERT_TRUE(spin_until(
         [&] {
-          return acked(tf_node.stats, seen_tf, stamp) && acked(topic_node.stats, seen_topic, stamp);
+          return tissue_test::stepped_on(tf_node.stats, seen_tf, stamp) &&
+                 tissue_test::stepped_on(topic_node.stats, seen_topic, stamp);
         },
         5.0))
         << "pose " << i << " was not stepped on by "
-        << (acked(tf_node.stats, seen_tf, stamp) ? "the topic node" : "the tf node");
+        << (tissue_test::stepped_on(tf_node.stats, seen_tf, stamp) ? "the topic node"
+                                                                   : "the tf node");
   }
   spin_for(1.5);  // the last surface, marker and hash
 

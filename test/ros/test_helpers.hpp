@@ -44,6 +44,14 @@ inline std::vector<geometry_msgs::PoseStamped> read_scalpel_poses(const std::str
   return poses;
 }
 
+// Did a step from stats[from] on use the pose stamped `stamp` (~stats scalpel_stamp)?
+inline bool stepped_on(const std::vector<soft_tissue_cutting::SimStats>& stats, size_t from,
+                       const ros::Time& stamp) {
+  for (size_t k = from; k < stats.size(); ++k)
+    if (stats[k].scalpel_stamp == stamp) return true;
+  return false;
+}
+
 // Lockstep replay: publishes `pose` and spins until a step has used it: a ~stats in `stats`
 // (appended by the caller's subscription) whose scalpel_stamp is the pose's stamp. The node's
 // loop samples the latest pose on its own clock, so a replay at the recorded pace would feed a
@@ -59,13 +67,7 @@ inline bool publish_in_lockstep(const ros::Publisher& pub, const geometry_msgs::
   if (pose.header.stamp.isZero()) return false;
   const size_t seen = stats.size();
   pub.publish(pose);  // original (old) stamps: never a reason to drop
-  return spin_until(
-      [&] {
-        for (size_t k = seen; k < stats.size(); ++k)
-          if (stats[k].scalpel_stamp == pose.header.stamp) return true;
-        return false;
-      },
-      timeout);
+  return spin_until([&] { return stepped_on(stats, seen, pose.header.stamp); }, timeout);
 }
 
 struct TriangleSoup {

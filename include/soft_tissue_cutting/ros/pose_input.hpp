@@ -81,6 +81,11 @@ class PoseInput {
   std::optional<Stamped> served_;  // queue_limit > 0: the last pose next() took
   std::uint64_t dropped_ = 0;
   int consecutive_jumps_ = 0;
+
+  // What the loop steps on now: the last pose taken (queue_limit > 0), else the newest.
+  const std::optional<Stamped>& current_locked() const {
+    return settings_.queue_limit > 0 ? served_ : last_;
+  }
 };
 
 // Distance (m) from p to the box; 0 inside.
