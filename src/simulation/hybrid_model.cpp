@@ -186,7 +186,14 @@ void HybridModel::rebuild_hybrid_system() {
 
 void HybridModel::refresh_factor() const {
   if (!factor_stale_) return;
-  solver_->set_matrix(a_, held_dofs());
+  LinearSolver::History history;
+  const std::vector<int>& now = dofs_.global_of;
+  const auto common = std::mismatch(solver_dofs_.begin(), solver_dofs_.end(), now.begin(),
+                                    now.begin() + std::min(now.size(), solver_dofs_.size()));
+  history.kept_rows = static_cast<int>(common.first - solver_dofs_.begin());
+  history.frozen_rows = static_cast<int>(interface_row_.size());  // the leading rows, never cut
+  solver_->set_matrix(a_, held_dofs(), history);
+  solver_dofs_ = now;
   factor_stale_ = false;
 }
 

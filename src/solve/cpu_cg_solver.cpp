@@ -11,7 +11,9 @@
 // Preconditioners z = M r (r is zero on constrained DOFs, and so is z):
 //   Jacobi:   M = P diag(A)^-1 P.
 //   Cholesky: M = P A^-1 P, A = L L^T factored by CHOLMOD in set_matrix, i.e. only when the
-//             hybrid matrix changes (construction, cuts, E changes; docs/DESIGN.md sections 4, 6).
+//             hybrid matrix changes (construction, cuts, E changes; docs/DESIGN.md sections 4, 6);
+//             a cut that changed nothing outside the frame kept by the last factorization
+//             refactors that frame alone (framed_cholesky.hpp, docs/DESIGN.md section 6.2).
 //             On the free DOFs M is (A^-1)_ff = S^-1 with S = A_ff - A_fc A_cc^-1 A_cf (block
 //             inverse), so the preconditioned operator is S^-1 A_ff = I + S^-1 A_fc A_cc^-1 A_cf:
 //             the identity plus rank <= #constrained DOFs. CG therefore needs at most
@@ -36,6 +38,7 @@
 //
 // The direct step (held_dof_solve) needs the factor of A itself: with held free-piece DOFs
 // left out of the factor (A_kk), a step is solved by the preconditioned CG alone.
+#include "soft_tissue_cutting/solve/framed_cholesky.hpp"
 #include "soft_tissue_cutting/solve/held_dof_solve.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
@@ -56,6 +59,14 @@ namespace {
 // zero pivot (~1e-16 n), far below anything that would slow the preconditioned CG.
 constexpr double kShift = 1e-9;
 
+// The frame a factorization after a cut keeps for the next cuts (framed_cholesky.hpp): the
+// rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
+// the same tets or their neighbours; two rings took 21 of 31 organ cuts instead of 18 but
+// doubled the frame's cost), and at most kMaxFrame DOFs: the frame's dense Schur complement
+// costs |B|^3/3 per cut (a change of E changes every row: no frame).
+constexpr int kFrameRings = 1;
+constexpr int kMaxFrame = 900;
+
 std::string format_residual(double r) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", r);
@@ -69,6 +80,7 @@ class CpuCgSolver final : public LinearSolver {
   std::string backend() const override { return "cpu"; }
   std::string preconditioner() const override { return active_; }
   double setup_ms() const override { return setup_ms_; }
+  int frame_updates() const override { return frame_updates_; }
   // Found on demand (one more factorization), so a cut whose first factor fails only until
   // its free pieces are held pays nothing for it.
   int singular_dof() const override {
@@ -83,7 +95,14 @@ class CpuCgSolver final : public LinearSolver {
   void set_matrix(const SparseMatrix& a) override { set_matrix(a, {}); }
 
   void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held) override {
+    set_matrix(a, held, History{});
+  }
+
+  void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
+                  const History& history) override {
     const auto t0 = std::chrono::steady_clock::now();
+    const Vector old_held_mask = held_mask_;
+    const Eigen::Index old_rows = a_.rows();
     a_ = a;
     kept_.clear();
     held_mask_ = Vector::Zero(a_.rows());
@@ -104,12 +123,19 @@ class CpuCgSolver final : public LinearSolver {
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
-    chol_.reset();
     held_.reset();
     factor_failed_ = false;
     singular_dof_.reset();
-    active_ = "jacobi";
-    if (wanted_ == CgPreconditioner::kCholesky) factor();
+    // The kept block's rows are the same DOFs as before when the matrix's are and no DOF of
+    // them changed its held state: then a cut within the last frame refactors the frame alone.
+    const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
+                           held_mask_.head(old_rows) == old_held_mask;
+    if (wanted_ == CgPreconditioner::kCholesky) {
+      factor(same_rows, history.frozen_rows);
+    } else {
+      chol_.reset();
+      active_ = "jacobi";
+    }
     setup_ms_ =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -269,18 +295,43 @@ class CpuCgSolver final : public LinearSolver {
   }
 
   // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
-  // active.
-  void factor() {
-    if (a_.rows() == 0) return;
-    const SparseMatrix block = factored_block();
-    if (block.rows() == 0) return;
+  // active. same_rows: the block's leading rows are the last block's DOFs, so the last factor
+  // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
+  // keeps a frame around what changed; its first `frozen` rows never change.
+  void factor(bool same_rows, int frozen) {
+    SparseMatrix block = factored_block();
+    if (block.rows() == 0) {
+      chol_.reset();
+      last_block_ = SparseMatrix();
+      active_ = "jacobi";
+      return;
+    }
+    if (same_rows && active_ == "cholesky" && chol_->update(block)) {
+      if (chol_->frame_size() <= kMaxFrame) {
+        last_block_ = std::move(block);
+        ++frame_updates_;
+        return;
+      }
+    }
+    std::vector<int> frame;
+    if (same_rows && last_block_.rows() > 0 && last_block_.rows() <= block.rows()) {
+      int frozen_kept = frozen;
+      if (!kept_.empty())
+        frozen_kept =
+            static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), frozen) - kept_.begin());
+      frame = FramedCholesky::frame_around_changes(last_block_, block, frozen_kept, kFrameRings);
+      if (static_cast<int>(frame.size()) > kMaxFrame) frame.clear();
+    }
+    chol_.reset();
+    active_ = "jacobi";
     try {
-      chol_ = std::make_unique<SparseCholesky>(block, CholeskyMethod::kSupernodal,
-                                               CholeskyOrdering::kAmd);
+      chol_ = std::make_unique<FramedCholesky>(block, frame);
       active_ = "cholesky";
+      last_block_ = std::move(block);
       return;
     } catch (const std::runtime_error&) {
       factor_failed_ = true;
+      last_block_ = SparseMatrix();
     }
     SparseMatrix shifted = block;
     const double dmax = block.diagonal().cwiseAbs().maxCoeff();
@@ -289,8 +340,7 @@ class CpuCgSolver final : public LinearSolver {
       shifted.coeffRef(i, i) += kShift * (d > 0 ? d : dmax);
     }
     try {
-      chol_ = std::make_unique<SparseCholesky>(shifted, CholeskyMethod::kSupernodal,
-                                               CholeskyOrdering::kAmd);
+      chol_ = std::make_unique<FramedCholesky>(shifted, std::vector<int>{});
       active_ = "cholesky (shifted)";
     } catch (const std::runtime_error&) {
       chol_.reset();
@@ -300,7 +350,8 @@ class CpuCgSolver final : public LinearSolver {
   CgPreconditioner wanted_;
   SparseMatrix a_;
   Vector inv_diag_;
-  std::unique_ptr<SparseCholesky> chol_;
+  std::unique_ptr<FramedCholesky> chol_;
+  SparseMatrix last_block_;  // the block chol_ was last set up for (what the next cut changes)
   // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;
@@ -311,6 +362,7 @@ class CpuCgSolver final : public LinearSolver {
   bool factor_failed_ = false;               // A (or A_kk) has no Cholesky factor
   mutable std::optional<int> singular_dof_;  // where, once asked (singular_dof())
   double setup_ms_ = 0;
+  int frame_updates_ = 0;
 };
 
 }  // namespace

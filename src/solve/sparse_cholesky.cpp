@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include "solve/blas_guard.hpp"
+#include "solve/upper_triangle.hpp"
 
 #include <Eigen/CholmodSupport>
 
@@ -34,6 +35,25 @@ int failed_column(const cholmod_factor* l) {
 }
 
 }  // namespace
+
+ColMatrix upper_triangle(const SparseMatrix& a) {
+  ColMatrix col(a.rows(), a.cols());
+  int count = 0;
+  for (int r = 0; r < a.outerSize(); ++r)
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it) count += it.col() <= r;
+  col.resizeNonZeros(count);
+  int* outer = col.outerIndexPtr();
+  int* inner = col.innerIndexPtr();
+  double* value = col.valuePtr();
+  int out = 0;
+  for (int r = 0; r < a.outerSize(); ++r) {  // row r of A: column r of the upper triangle
+    outer[r] = out;
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
+      if (it.col() <= r) inner[out] = static_cast<int>(it.col()), value[out++] = it.value();
+  }
+  outer[a.outerSize()] = out;
+  return col;
+}
 
 struct SparseCholesky::Impl {
   FactorOf<Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Upper>> supernodal;
@@ -86,30 +106,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& a, CholeskyMethod method,
       c->nmethods = 1;
       c->method[0].ordering = CHOLMOD_AMD;
     }
-  // A is symmetric, so its row-major arrays are also its column-major arrays: copied as they
-  // are instead of transposed. CHOLMOD is shown the upper triangle (A's lower one, equal to
-  // rounding): its analysis orders and builds the elimination tree from the upper triangle, so
-  // a lower one is transposed first on every factorization (7 % of the thigh's cutting step).
-  // Only that triangle is passed: CHOLMOD scans every stored entry (and skips the other
-  // triangle's) in its analysis and in the factorization's scatter of A.
-  ColMatrix col(a.rows(), a.cols());
-  {
-    const SparseMatrix& c = a;
-    int count = 0;
-    for (int r = 0; r < c.outerSize(); ++r)
-      for (SparseMatrix::InnerIterator it(c, r); it; ++it) count += it.col() <= r;
-    col.resizeNonZeros(count);
-    int* outer = col.outerIndexPtr();
-    int* inner = col.innerIndexPtr();
-    double* value = col.valuePtr();
-    int out = 0;
-    for (int r = 0; r < c.outerSize(); ++r) {  // row r of A: column r of the upper triangle
-      outer[r] = out;
-      for (SparseMatrix::InnerIterator it(c, r); it; ++it)
-        if (it.col() <= r) inner[out] = static_cast<int>(it.col()), value[out++] = it.value();
-    }
-    outer[c.outerSize()] = out;
-  }
+  const ColMatrix col = upper_triangle(a);
   // Failure is reported by the exception below; callers that probe (the Cholesky-PCG falls
   // back on failure) must not leave CHOLMOD's "not positive definite" warning on stderr.
   Eigen::ComputationInfo info;

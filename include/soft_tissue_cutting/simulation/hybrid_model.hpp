@@ -171,6 +171,9 @@ class HybridModel {
   bool system_changed_ = true;  // matrix, rhs or u_ changed since the last solve
   // The solver has not seen the current matrix or held set yet (set up at first use).
   mutable bool factor_stale_ = false;
+  // The DOFs (global_of) of the matrix the solver last saw: a cut keeps them and appends its
+  // new nodes', so the solver may refactor only what changed (LinearSolver::History).
+  mutable std::vector<int> solver_dofs_;
   void refresh_factor() const;
   ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;

@@ -54,6 +54,9 @@ class LinearSolver {
   // found it not positive definite: a mode of the system that nothing holds involves it. -1:
   // it factored, or this solver does not factor (Jacobi, gl).
   virtual int singular_dof() const { return -1; }
+  // How many set_matrix calls so far refactored only the frame around the last cut
+  // (framed_cholesky.hpp); 0 for a solver that does not.
+  virtual int frame_updates() const { return 0; }
   // Wall time of the last set_matrix in ms (factorization, for the Cholesky preconditioner).
   virtual double setup_ms() const { return 0; }
   // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.
@@ -65,6 +68,19 @@ class LinearSolver {
   virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held) {
     (void)held;
     set_matrix(a);
+  }
+  // The same, knowing how `a` relates to the last matrix: its first `kept_rows` rows are the
+  // same DOFs as the last matrix's (a cut appends the DOFs of its new nodes), and its first
+  // `frozen_rows` rows never change (the interface block, docs/DESIGN.md section 4). A solver
+  // may then refactor only what changed (cpu_cg_solver.cpp). Default: set_matrix(a, held).
+  struct History {
+    int kept_rows = 0;
+    int frozen_rows = 0;
+  };
+  virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
+                          const History& history) {
+    (void)history;
+    set_matrix(a, held);
   }
   virtual CgResult solve(const Vector& b, Vector& x, const std::vector<std::uint8_t>& constrained,
                          const CgSettings& settings) = 0;

@@ -25,10 +25,20 @@ enum class CholeskyMethod { kSupernodal, kSimplicial };
 // factor entries) while the analysis took 2-3x longer (18 vs 8 ms), and every cut re-analyses.
 enum class CholeskyOrdering { kDefault, kAmd };
 
-class SparseCholesky {
+// What the capacitance solve (held_dof_solve.hpp) and the preconditioned CG need of a factor.
+class CholeskySolve {
+ public:
+  virtual ~CholeskySolve() = default;
+  // X = A^-1 B for all columns of B at once.
+  virtual Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const = 0;
+  virtual Vector solve(const Vector& b) const = 0;
+  virtual int rows() const = 0;
+};
+
+class SparseCholesky final : public CholeskySolve {
  public:
   SparseCholesky();
-  ~SparseCholesky();
+  ~SparseCholesky() override;
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
@@ -46,9 +56,9 @@ class SparseCholesky {
   // X = A^-1 B for all columns of B in one CHOLMOD call. Thread-safe: the factor is never
   // changed after construction and each call has its own CHOLMOD workspace, so threads may
   // share one factor (the condensed part's, recovered on the ROS display thread).
-  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
-  Vector solve(const Vector& b) const;
-  int rows() const { return rows_; }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const override;
+  Vector solve(const Vector& b) const override;
+  int rows() const override { return rows_; }
 
  private:
   struct Impl;

@@ -3,5 +3,6 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/solve/test_blas_guard.cpp
   test/unit/solve/test_cpu_cg_preconditioner.cpp
   test/unit/solve/test_cpu_cg_solver.cpp
+  test/unit/solve/test_framed_cholesky.cpp
   test/unit/solve/test_held_dof_solve.cpp
 )

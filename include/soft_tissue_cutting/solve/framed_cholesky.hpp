@@ -1,0 +1,66 @@
+// A sparse Cholesky factor of the hybrid matrix whose trailing block, the frame around the
+// last cut, is refactored alone when a cut changes nothing outside it (docs/DESIGN.md section 6,
+// "A cut refactors its frame").
+//
+// A cut changes the stiffness of a few tets near the blade and appends the DOFs of the nodes it
+// creates; every other row of the hybrid matrix, the dense interface block K0 above all, stays
+// as it was. With the frame's DOFs B ordered after all the others F, A = L L^T has
+//   L = [L_FF 0; L_BF L_BB],   L_BB L_BB^T = A_BB - W,   W = A_BF A_FF^-1 A_FB,
+// and L_FF, L_BF and W depend on A_FF and A_FB only. A matrix that differs from the factored one
+// in its frame rows alone (new DOFs join the frame; they couple to frame DOFs only) is factored
+// by the dense Cholesky of its frame's Schur complement S' = A'_BB - W, eq. (26): the organ
+// liver's 2,500-DOF factor with its 636-DOF dense interface block costs ~9 ms, a frame of a few
+// hundred DOFs well under one. Solves use the kept sparse factor for the F part, eq. (27):
+//   z = L^-1 P b,  r_B = L_BB z_B (= b_B - L_BF z_F),  x_B = S'^-1 r_B,
+//   x = P^T L^-T [z_F; L_BB^T x_B]
+// (the last solve's trailing block returns x_B itself; only its F rows are new), exact to the
+// rounding of a direct solve.
+#pragma once
+
+#include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace stc {
+
+class FramedCholesky final : public CholeskySolve {
+ public:
+  // Factors `a` (SPD, both triangles stored) with the DOFs in `frame` eliminated last and the
+  // others in AMD order. Throws std::runtime_error if `a` is not positive definite.
+  FramedCholesky(const SparseMatrix& a, std::vector<int> frame);
+  ~FramedCholesky() override;
+  FramedCholesky(const FramedCholesky&) = delete;
+  FramedCholesky& operator=(const FramedCholesky&) = delete;
+
+  // Takes `a` by refactoring the frame alone if it can: `a`'s leading rows() rows are the same
+  // DOFs as the factored matrix's, every row outside the frame is unchanged (pattern and values),
+  // and the frame's Schur complement is positive definite. Rows beyond rows() are new DOFs and
+  // join the frame. Returns false, leaving this factor as it was, otherwise.
+  bool update(const SparseMatrix& a);
+
+  Vector solve(const Vector& b) const override;
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const override;
+  int rows() const override { return rows_; }
+  int frame_size() const { return static_cast<int>(frame_.size()); }
+  // Rows of the factored matrix (the F rows' reference) and of the last taken one.
+  int factored_rows() const;
+  int updates() const { return updates_; }
+
+  // The rows where `a` differs from `previous` (same leading rows; rows beyond previous.rows()
+  // count as changed), grown by `rings` rings of neighbours in `a`'s graph, never into the first
+  // `frozen` rows: the frame to factor `a` with so that the next cuts nearby fall inside it.
+  static std::vector<int> frame_around_changes(const SparseMatrix& previous, const SparseMatrix& a,
+                                               int frozen, int rings);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<int> frame_;  // frame DOFs in their elimination order, new DOFs last
+  int rows_ = 0;
+  int updates_ = 0;
+};
+
+}  // namespace stc

@@ -1,0 +1,289 @@
+#include "soft_tissue_cutting/solve/framed_cholesky.hpp"
+
+#include "solve/blas_guard.hpp"
+#include "solve/upper_triangle.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+// LAPACK and BLAS (OpenBLAS through Debian's alternatives, as CHOLMOD's): the frame's dense
+// Schur complement is factored and applied at BLAS speed, not Eigen's portable kernels.
+extern "C" {
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
+             double* b, const int* ldb, int* info);
+void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
+            const int* n, const double* alpha, const double* a, const int* lda, double* b,
+            const int* ldb);
+void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha,
+            const double* a, const int* lda, const double* beta, double* c, const int* ldc);
+}
+
+namespace stc {
+namespace {
+
+// B = op(L) B with L lower triangular (n x n, column-major), B n x m.
+void lower_times(const Eigen::MatrixXd& l, bool transpose, Eigen::MatrixXd& b) {
+  const int n = static_cast<int>(l.rows()), m = static_cast<int>(b.cols());
+  if (n == 0 || m == 0) return;
+  const double one = 1.0;
+  dtrmm_("L", "L", transpose ? "T" : "N", "N", &n, &m, &one, l.data(), &n, b.data(), &n);
+}
+
+bool same_row(const SparseMatrix& a, const SparseMatrix& b, int r) {
+  const int na = a.outerIndexPtr()[r + 1] - a.outerIndexPtr()[r];
+  const int nb = b.outerIndexPtr()[r + 1] - b.outerIndexPtr()[r];
+  if (na != nb) return false;
+  const int* ia = a.innerIndexPtr() + a.outerIndexPtr()[r];
+  const int* ib = b.innerIndexPtr() + b.outerIndexPtr()[r];
+  const double* va = a.valuePtr() + a.outerIndexPtr()[r];
+  const double* vb = b.valuePtr() + b.outerIndexPtr()[r];
+  return std::equal(ia, ia + na, ib) && std::equal(va, va + na, vb);
+}
+
+}  // namespace
+
+struct FramedCholesky::Impl {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  SparseMatrix factored;           // the matrix L L^T is of: its F rows are the reference
+  std::vector<int> perm;           // elimination order: perm[k] is the row eliminated k-th
+  int n_f = 0;                     // rows of F (perm[0, n_f)); the old frame is perm[n_f, n)
+  std::vector<char> in_old_frame;  // per factored row
+  Eigen::MatrixXd l_bb;            // L's trailing frame block (lower, column-major)
+  Eigen::MatrixXd w;               // W = A_BB - L_BB L_BB^T, eq. (26) (lower triangle used)
+  Eigen::MatrixXd schur;           // the Cholesky factor of S' (lower), once update() took a matrix
+  bool updated = false;
+
+  Impl() {
+    cholmod_start(&common);
+    common.print = 0;
+  }
+  ~Impl() {
+    if (factor) cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+
+  // x = L^-1 b (sys CHOLMOD_L) or L^-T b (CHOLMOD_Lt), no permutation; b is n x m.
+  Eigen::MatrixXd triangular_solve(int sys, const Eigen::MatrixXd& b) const {
+    cholmod_common c;
+    cholmod_start(&c);
+    c.print = 0;
+    cholmod_dense rhs{};
+    rhs.nrow = rhs.d = static_cast<size_t>(b.rows());
+    rhs.ncol = static_cast<size_t>(b.cols());
+    rhs.nzmax = rhs.nrow * rhs.ncol;
+    rhs.x = const_cast<double*>(b.data());  // read only
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* x = nullptr;
+    {
+      const auto blas = blas_guard();
+      x = cholmod_solve(sys, factor, &rhs, &c);
+    }
+    if (!x) {
+      cholmod_finish(&c);
+      throw std::runtime_error("framed Cholesky (CHOLMOD): the solve failed (out of memory?)");
+    }
+    Eigen::MatrixXd out =
+        Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), b.rows(), b.cols());
+    cholmod_free_dense(&x, &c);
+    cholmod_finish(&c);
+    return out;
+  }
+};
+
+FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
+    : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
+  blas_info();  // before CHOLMOD's first call (solve/blas_guard.hpp)
+  Impl& m = *impl_;
+  const int n = rows_;
+  m.factored = a;
+  m.in_old_frame.assign(static_cast<size_t>(n), 0);
+  std::sort(frame.begin(), frame.end());
+  frame.erase(std::unique(frame.begin(), frame.end()), frame.end());
+  for (int r : frame) {
+    if (r < 0 || r >= n) throw std::invalid_argument("FramedCholesky: frame row out of range");
+    m.in_old_frame[static_cast<size_t>(r)] = 1;
+  }
+  if (n == 0) return;
+
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> upper = upper_triangle(a);
+  cholmod_sparse view = Eigen::viewAsCholmod(upper);
+  view.stype = 1;  // the upper triangle of a symmetric matrix
+  // Constrained AMD: every F row before every frame row (set 0 before set 1), each set in
+  // AMD order. CHOLMOD then analyses that order as given and does not postorder it: a
+  // postorder may move F columns behind frame columns.
+  std::vector<int> member(static_cast<size_t>(n));
+  for (int r = 0; r < n; ++r)
+    member[static_cast<size_t>(r)] = m.in_old_frame[static_cast<size_t>(r)];
+  m.perm.assign(static_cast<size_t>(n), 0);
+  if (!cholmod_camd(&view, nullptr, 0, member.data(), m.perm.data(), &m.common))
+    throw std::runtime_error("framed Cholesky (CHOLMOD): the constrained ordering failed");
+  m.common.nmethods = 1;
+  m.common.method[0].ordering = CHOLMOD_GIVEN;
+  m.common.postorder = false;
+  m.common.supernodal = CHOLMOD_SUPERNODAL;
+  m.factor = cholmod_analyze_p(&view, m.perm.data(), nullptr, 0, &m.common);
+  if (!m.factor) throw std::runtime_error("framed Cholesky (CHOLMOD): the analysis failed");
+  {
+    const auto blas = blas_guard();
+    cholmod_factorize(&view, m.factor, &m.common);
+  }
+  if (m.common.status == CHOLMOD_NOT_POSDEF || m.factor->minor < m.factor->n)
+    throw std::runtime_error(
+        "framed Cholesky (CHOLMOD): matrix not positive definite - a part of the mesh is "
+        "neither fixed nor held by the interface");
+  const int* p = static_cast<const int*>(m.factor->Perm);
+  if (!std::equal(m.perm.begin(), m.perm.end(), p))
+    throw std::logic_error("framed Cholesky: CHOLMOD did not keep the given order");
+  m.n_f = n - static_cast<int>(frame.size());
+  frame_.assign(m.perm.begin() + m.n_f, m.perm.end());
+
+  // L_BB from the supernodes (column-major blocks: the rows of supernode s are
+  // Ls[pi[s] .. pi[s+1]), its columns super[s] .. super[s+1]).
+  const int nb = static_cast<int>(frame_.size());
+  m.l_bb = Eigen::MatrixXd::Zero(nb, nb);
+  const auto* super = static_cast<const int*>(m.factor->super);
+  const auto* pi = static_cast<const int*>(m.factor->pi);
+  const auto* px = static_cast<const int*>(m.factor->px);
+  const auto* ls = static_cast<const int*>(m.factor->s);
+  const auto* lx = static_cast<const double*>(m.factor->x);
+  for (size_t s = 0; s < m.factor->nsuper; ++s) {
+    if (super[s + 1] <= m.n_f) continue;
+    const int nrows = pi[s + 1] - pi[s];
+    for (int j = std::max(super[s], m.n_f); j < super[s + 1]; ++j) {
+      const double* col = lx + px[s] + static_cast<ptrdiff_t>(j - super[s]) * nrows;
+      for (int ii = j - super[s]; ii < nrows; ++ii)  // rows >= j: the lower part
+        m.l_bb(ls[pi[s] + ii] - m.n_f, j - m.n_f) = col[ii];
+    }
+  }
+  // W = A_BB - L_BB L_BB^T (eq. (26)): what F adds to the frame's Schur complement.
+  std::vector<int> pos(static_cast<size_t>(n), -1);
+  for (int j = 0; j < nb; ++j) pos[static_cast<size_t>(frame_[static_cast<size_t>(j)])] = j;
+  m.w = Eigen::MatrixXd::Zero(nb, nb);
+  for (int j = 0; j < nb; ++j)
+    for (SparseMatrix::InnerIterator it(a, frame_[static_cast<size_t>(j)]); it; ++it)
+      if (const int i = pos[static_cast<size_t>(it.index())]; i >= 0) m.w(i, j) = it.value();
+  if (nb > 0) {
+    const double minus_one = -1.0, one = 1.0;
+    const auto blas = blas_guard();
+    dsyrk_("L", "N", &nb, &nb, &minus_one, m.l_bb.data(), &nb, &one, m.w.data(), &nb);
+  }
+}
+
+FramedCholesky::~FramedCholesky() = default;
+
+int FramedCholesky::factored_rows() const { return static_cast<int>(impl_->factored.rows()); }
+
+bool FramedCholesky::update(const SparseMatrix& a) {
+  Impl& m = *impl_;
+  const int n_old = static_cast<int>(m.factored.rows());
+  const int n = static_cast<int>(a.rows());
+  if (n < n_old || m.factor == nullptr) return false;
+  for (int r = 0; r < n_old; ++r)
+    if (!m.in_old_frame[static_cast<size_t>(r)] && !same_row(a, m.factored, r)) return false;
+  // The frame: the old one in its elimination order, then the new DOFs.
+  const int nb_old = n_old - m.n_f, nb = nb_old + (n - n_old);
+  std::vector<int> frame(frame_.begin(), frame_.begin() + nb_old);
+  for (int r = n_old; r < n; ++r) frame.push_back(r);
+  std::vector<int> pos(static_cast<size_t>(n), -1);
+  for (int j = 0; j < nb; ++j) pos[static_cast<size_t>(frame[static_cast<size_t>(j)])] = j;
+  // S' = A'_BB - W (eq. (26)), lower triangle; W is zero on the new DOFs.
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(nb, nb);
+  s.topLeftCorner(nb_old, nb_old) = -m.w;
+  for (int j = 0; j < nb; ++j)
+    for (SparseMatrix::InnerIterator it(a, frame[static_cast<size_t>(j)]); it; ++it) {
+      const int i = pos[static_cast<size_t>(it.index())];
+      if (i >= j) s(i, j) += it.value();
+    }
+  int info = 0;
+  if (nb > 0) {
+    const auto blas = blas_guard();
+    dpotrf_("L", &nb, s.data(), &nb, &info);
+  }
+  if (info != 0) return false;  // not positive definite: the caller refactors (and diagnoses)
+  m.schur = std::move(s);
+  m.updated = true;
+  frame_ = std::move(frame);
+  rows_ = n;
+  ++updates_;
+  return true;
+}
+
+Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
+  if (b.rows() != rows_) throw std::invalid_argument("FramedCholesky::solve: size mismatch");
+  const Impl& m = *impl_;
+  const Eigen::Index cols = b.cols();
+  if (rows_ == 0 || cols == 0) return Eigen::MatrixXd::Zero(rows_, cols);
+  const int n_old = static_cast<int>(m.factored.rows());
+  const int nb_old = n_old - m.n_f, nb = static_cast<int>(frame_.size());
+  if (!m.updated) {
+    Eigen::MatrixXd bp(n_old, cols);
+    for (int k = 0; k < n_old; ++k) bp.row(k) = b.row(m.perm[static_cast<size_t>(k)]);
+    const Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, m.triangular_solve(CHOLMOD_L, bp));
+    Eigen::MatrixXd x(rows_, cols);
+    for (int k = 0; k < n_old; ++k) x.row(m.perm[static_cast<size_t>(k)]) = xp.row(k);
+    return x;
+  }
+  // Eq. (27): z = L^-1 P b with the kept factor; its frame rows give r_B = b_B - L_BF z_F.
+  Eigen::MatrixXd bp(n_old, cols);
+  for (int k = 0; k < n_old; ++k) bp.row(k) = b.row(m.perm[static_cast<size_t>(k)]);
+  Eigen::MatrixXd z = m.triangular_solve(CHOLMOD_L, bp);
+  Eigen::MatrixXd x_b(nb, cols);
+  Eigen::MatrixXd r_old = z.bottomRows(nb_old);
+  lower_times(m.l_bb, false, r_old);
+  x_b.topRows(nb_old) = r_old;
+  for (int j = nb_old; j < nb; ++j) x_b.row(j) = b.row(frame_[static_cast<size_t>(j)]);
+  int info = 0;
+  const int ncols = static_cast<int>(cols);
+  {
+    const auto blas = blas_guard();
+    dpotrs_("L", &nb, &ncols, m.schur.data(), &nb, x_b.data(), &nb, &info);
+  }
+  // Back: L^T x_p = [z_F; L_BB^T x_B] returns x_B in its frame rows and x_F above them.
+  Eigen::MatrixXd top = x_b.topRows(nb_old);
+  lower_times(m.l_bb, true, top);
+  z.bottomRows(nb_old) = top;
+  const Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
+  Eigen::MatrixXd x(rows_, cols);
+  for (int k = 0; k < m.n_f; ++k) x.row(m.perm[static_cast<size_t>(k)]) = xp.row(k);
+  for (int j = 0; j < nb; ++j) x.row(frame_[static_cast<size_t>(j)]) = x_b.row(j);
+  return x;
+}
+
+Vector FramedCholesky::solve(const Vector& b) const { return solve(Eigen::MatrixXd(b)).col(0); }
+
+std::vector<int> FramedCholesky::frame_around_changes(const SparseMatrix& previous,
+                                                      const SparseMatrix& a, int frozen,
+                                                      int rings) {
+  const int n = static_cast<int>(a.rows()), n_old = static_cast<int>(previous.rows());
+  std::vector<char> in(static_cast<size_t>(n), 0);
+  std::vector<int> layer;
+  for (int r = 0; r < n; ++r)
+    if (r >= n_old || !same_row(a, previous, r)) {
+      if (r < frozen) continue;
+      in[static_cast<size_t>(r)] = 1;
+      layer.push_back(r);
+    }
+  for (int ring = 0; ring < rings && !layer.empty(); ++ring) {
+    std::vector<int> next;
+    for (int r : layer)
+      for (SparseMatrix::InnerIterator it(a, r); it; ++it) {
+        const int c = static_cast<int>(it.index());
+        if (c < frozen || in[static_cast<size_t>(c)]) continue;
+        in[static_cast<size_t>(c)] = 1;
+        next.push_back(c);
+      }
+    layer = std::move(next);
+  }
+  std::vector<int> frame;
+  for (int r = 0; r < n; ++r)
+    if (in[static_cast<size_t>(r)]) frame.push_back(r);
+  return frame;
+}
+
+}  // namespace stc
