@@ -191,7 +191,7 @@ void HybridModel::refresh_factor() const {
   const auto common = std::mismatch(solver_dofs_.begin(), solver_dofs_.end(), now.begin(),
                                     now.begin() + std::min(now.size(), solver_dofs_.size()));
   history.kept_rows = static_cast<int>(common.first - solver_dofs_.begin());
-  history.frozen_rows = static_cast<int>(interface_row_.size());  // the leading rows, never cut
+  history.interface_rows = static_cast<int>(interface_row_.size());  // the leading rows
   solver_->set_matrix(a_, held_dofs(), history);
   solver_dofs_ = now;
   factor_stale_ = false;

@@ -131,7 +131,7 @@ class CpuCgSolver final : public LinearSolver {
     const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
                            held_mask_.head(old_rows) == old_held_mask;
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.frozen_rows);
+      factor(same_rows, history.interface_rows);
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -297,8 +297,8 @@ class CpuCgSolver final : public LinearSolver {
   // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
   // active. same_rows: the block's leading rows are the last block's DOFs, so the last factor
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
-  // keeps a frame around what changed; its first `frozen` rows never change.
-  void factor(bool same_rows, int frozen) {
+  // keeps a frame around what changed; its first `interface` rows are the dense interface block.
+  void factor(bool same_rows, int interface) {
     SparseMatrix block = factored_block();
     if (block.rows() == 0) {
       chol_.reset();
@@ -315,11 +315,11 @@ class CpuCgSolver final : public LinearSolver {
     }
     std::vector<int> frame;
     if (same_rows && last_block_.rows() > 0 && last_block_.rows() <= block.rows()) {
-      int frozen_kept = frozen;
+      int dense = interface;
       if (!kept_.empty())
-        frozen_kept =
-            static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), frozen) - kept_.begin());
-      frame = FramedCholesky::frame_around_changes(last_block_, block, frozen_kept, kFrameRings);
+        dense = static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) -
+                                 kept_.begin());
+      frame = FramedCholesky::frame_around_changes(last_block_, block, dense, kFrameRings);
       if (static_cast<int>(frame.size()) > kMaxFrame) frame.clear();
     }
     chol_.reset();

@@ -18,6 +18,10 @@ void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, c
 void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
             const int* n, const double* alpha, const double* a, const int* lda, double* b,
             const int* ldb);
+void dtrmv_(const char* uplo, const char* trans, const char* diag, const int* n, const double* a,
+            const int* lda, double* x, const int* incx);
+void dtrsv_(const char* uplo, const char* trans, const char* diag, const int* n, const double* a,
+            const int* lda, double* x, const int* incx);
 void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha,
             const double* a, const int* lda, const double* beta, double* c, const int* ldc);
 }
@@ -25,12 +29,29 @@ void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, con
 namespace stc {
 namespace {
 
-// B = op(L) B with L lower triangular (n x n, column-major), B n x m.
+// B = op(L) B with L lower triangular (n x n, column-major), B n x m. One column goes through
+// the level-2 routine: OpenBLAS's level-3 one packs all of L first (3x slower for m = 1).
 void lower_times(const Eigen::MatrixXd& l, bool transpose, Eigen::MatrixXd& b) {
-  const int n = static_cast<int>(l.rows()), m = static_cast<int>(b.cols());
+  const int n = static_cast<int>(l.rows()), m = static_cast<int>(b.cols()), one_step = 1;
   if (n == 0 || m == 0) return;
   const double one = 1.0;
-  dtrmm_("L", "L", transpose ? "T" : "N", "N", &n, &m, &one, l.data(), &n, b.data(), &n);
+  if (m == 1)
+    dtrmv_("L", transpose ? "T" : "N", "N", &n, l.data(), &n, b.data(), &one_step);
+  else
+    dtrmm_("L", "L", transpose ? "T" : "N", "N", &n, &m, &one, l.data(), &n, b.data(), &n);
+}
+
+// B = (L L^T)^-1 B for the Cholesky factor L (lower, n x n), B n x m.
+void cholesky_solve(const Eigen::MatrixXd& l, Eigen::MatrixXd& b) {
+  const int n = static_cast<int>(l.rows()), m = static_cast<int>(b.cols()), one_step = 1;
+  if (n == 0 || m == 0) return;
+  if (m == 1) {
+    dtrsv_("L", "N", "N", &n, l.data(), &n, b.data(), &one_step);
+    dtrsv_("L", "T", "N", &n, l.data(), &n, b.data(), &one_step);
+    return;
+  }
+  int info = 0;
+  dpotrs_("L", &n, &m, l.data(), &n, b.data(), &n, &info);
 }
 
 bool same_row(const SparseMatrix& a, const SparseMatrix& b, int r) {
@@ -234,20 +255,18 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
   for (int k = 0; k < n_old; ++k) bp.row(k) = b.row(m.perm[static_cast<size_t>(k)]);
   Eigen::MatrixXd z = m.triangular_solve(CHOLMOD_L, bp);
   Eigen::MatrixXd x_b(nb, cols);
-  Eigen::MatrixXd r_old = z.bottomRows(nb_old);
-  lower_times(m.l_bb, false, r_old);
-  x_b.topRows(nb_old) = r_old;
-  for (int j = nb_old; j < nb; ++j) x_b.row(j) = b.row(frame_[static_cast<size_t>(j)]);
-  int info = 0;
-  const int ncols = static_cast<int>(cols);
   {
     const auto blas = blas_guard();
-    dpotrs_("L", &nb, &ncols, m.schur.data(), &nb, x_b.data(), &nb, &info);
+    Eigen::MatrixXd r_old = z.bottomRows(nb_old);
+    lower_times(m.l_bb, false, r_old);
+    x_b.topRows(nb_old) = r_old;
+    for (int j = nb_old; j < nb; ++j) x_b.row(j) = b.row(frame_[static_cast<size_t>(j)]);
+    cholesky_solve(m.schur, x_b);
+    // Back: L^T x_p = [z_F; L_BB^T x_B] returns x_B in its frame rows and x_F above them.
+    Eigen::MatrixXd top = x_b.topRows(nb_old);
+    lower_times(m.l_bb, true, top);
+    z.bottomRows(nb_old) = top;
   }
-  // Back: L^T x_p = [z_F; L_BB^T x_B] returns x_B in its frame rows and x_F above them.
-  Eigen::MatrixXd top = x_b.topRows(nb_old);
-  lower_times(m.l_bb, true, top);
-  z.bottomRows(nb_old) = top;
   const Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
   Eigen::MatrixXd x(rows_, cols);
   for (int k = 0; k < m.n_f; ++k) x.row(m.perm[static_cast<size_t>(k)]) = xp.row(k);
@@ -258,25 +277,23 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
 Vector FramedCholesky::solve(const Vector& b) const { return solve(Eigen::MatrixXd(b)).col(0); }
 
 std::vector<int> FramedCholesky::frame_around_changes(const SparseMatrix& previous,
-                                                      const SparseMatrix& a, int frozen,
-                                                      int rings) {
+                                                      const SparseMatrix& a, int dense, int rings) {
   const int n = static_cast<int>(a.rows()), n_old = static_cast<int>(previous.rows());
   std::vector<char> in(static_cast<size_t>(n), 0);
   std::vector<int> layer;
   for (int r = 0; r < n; ++r)
     if (r >= n_old || !same_row(a, previous, r)) {
-      if (r < frozen) continue;
       in[static_cast<size_t>(r)] = 1;
-      layer.push_back(r);
+      if (r >= dense) layer.push_back(r);
     }
   for (int ring = 0; ring < rings && !layer.empty(); ++ring) {
     std::vector<int> next;
     for (int r : layer)
       for (SparseMatrix::InnerIterator it(a, r); it; ++it) {
         const int c = static_cast<int>(it.index());
-        if (c < frozen || in[static_cast<size_t>(c)]) continue;
+        if (in[static_cast<size_t>(c)]) continue;
         in[static_cast<size_t>(c)] = 1;
-        next.push_back(c);
+        if (c >= dense) next.push_back(c);
       }
     layer = std::move(next);
   }

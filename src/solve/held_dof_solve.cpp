@@ -20,8 +20,8 @@ void HeldDofSolve::reset() {
   w_.resize(0, 0);
 }
 
-void HeldDofSolve::solve(const CholeskySolve& factor, const Vector& b,
-                         const std::vector<int>& held, Vector& x) {
+void HeldDofSolve::solve(const CholeskySolve& factor, const Vector& b, const std::vector<int>& held,
+                         Vector& x) {
   const Eigen::Index n = b.size();
   if (!have_y_ || b_.size() != n || b_ != b) {
     y_ = factor.solve(b);

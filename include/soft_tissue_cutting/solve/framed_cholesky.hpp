@@ -50,10 +50,11 @@ class FramedCholesky final : public CholeskySolve {
   int updates() const { return updates_; }
 
   // The rows where `a` differs from `previous` (same leading rows; rows beyond previous.rows()
-  // count as changed), grown by `rings` rings of neighbours in `a`'s graph, never into the first
-  // `frozen` rows: the frame to factor `a` with so that the next cuts nearby fall inside it.
+  // count as changed), grown by `rings` rings of neighbours in `a`'s graph: the frame to factor
+  // `a` with so that the next cuts nearby fall inside it. The first `dense` rows (the interface
+  // block, where each row neighbours all the others) join it but never grow it.
   static std::vector<int> frame_around_changes(const SparseMatrix& previous, const SparseMatrix& a,
-                                               int frozen, int rings);
+                                               int dense, int rings);
 
  private:
   struct Impl;

@@ -23,8 +23,7 @@ class HeldDofSolve {
   void reset();
   // x on entry: held DOFs (held[i] rows) carry their prescribed values; on return every other
   // row holds the solution of A_ff x_f = b_f - A_fc x_c through `factor` (A = L L^T).
-  void solve(const CholeskySolve& factor, const Vector& b, const std::vector<int>& held,
-             Vector& x);
+  void solve(const CholeskySolve& factor, const Vector& b, const std::vector<int>& held, Vector& x);
   // Columns of W currently kept (for tests).
   int kept_columns() const { return static_cast<int>(column_of_.size()); }
 

@@ -71,11 +71,11 @@ class LinearSolver {
   }
   // The same, knowing how `a` relates to the last matrix: its first `kept_rows` rows are the
   // same DOFs as the last matrix's (a cut appends the DOFs of its new nodes), and its first
-  // `frozen_rows` rows never change (the interface block, docs/DESIGN.md section 4). A solver
+  // `interface_rows` rows are the dense interface block (docs/DESIGN.md section 4). A solver
   // may then refactor only what changed (cpu_cg_solver.cpp). Default: set_matrix(a, held).
   struct History {
     int kept_rows = 0;
-    int frozen_rows = 0;
+    int interface_rows = 0;
   };
   virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                           const History& history) {

@@ -49,7 +49,7 @@ struct StrokeCounts {
 // and both solves are compared with a fresh factorization of the same matrix.
 StrokeCounts framed_along_stroke(const Scene& scene, const std::string& what) {
   Simulation sim(scene);
-  const int frozen = 3 * static_cast<int>(sim.model().partition().interface.size());
+  const int dense = 3 * static_cast<int>(sim.model().partition().interface.size());
   std::unique_ptr<FramedCholesky> factor;
   SparseMatrix previous = sim.model().hybrid_matrix();
   StrokeCounts n;
@@ -70,7 +70,7 @@ StrokeCounts framed_along_stroke(const Scene& scene, const std::string& what) {
       ++n.updates;
     } else {
       factor = std::make_unique<FramedCholesky>(
-          a, FramedCholesky::frame_around_changes(previous, a, frozen, 1));
+          a, FramedCholesky::frame_around_changes(previous, a, dense, 1));
     }
     previous = a;
     EXPECT_EQ(factor->rows(), a.rows()) << what;
@@ -109,23 +109,23 @@ TEST(FramedCholesky, CutStrokeEqualsFreshFactorOnTetgenLiver) {
 struct Framed {
   SparseMatrix a;
   std::vector<int> frame;
-  int outside = -1;  // a row outside the frame, not frozen
-  int frozen = 0;    // the interface rows
+  int outside = -1;  // a row outside the frame, not an interface row
+  int dense = 0;     // the interface rows
 };
 
 Framed thigh_matrix() {
   const HybridModel h(make_thigh_scene());
   Framed f;
   f.a = h.hybrid_matrix();
-  const int frozen = 3 * static_cast<int>(h.partition().interface.size());
-  f.frozen = frozen;
+  const int dense = 3 * static_cast<int>(h.partition().interface.size());
+  f.dense = dense;
   // Pretend the last row changed: its neighbours, one ring, are the frame.
   SparseMatrix before = f.a;
   before.coeffRef(f.a.rows() - 1, f.a.rows() - 1) *= 2;
-  f.frame = FramedCholesky::frame_around_changes(before, f.a, frozen, 1);
+  f.frame = FramedCholesky::frame_around_changes(before, f.a, dense, 1);
   std::vector<char> in(static_cast<size_t>(f.a.rows()), 0);
   for (int r : f.frame) in[static_cast<size_t>(r)] = 1;
-  for (int r = f.a.rows() - 1; r >= frozen; --r)
+  for (int r = f.a.rows() - 1; r >= dense; --r)
     if (!in[static_cast<size_t>(r)]) {
       f.outside = r;
       break;
@@ -136,12 +136,18 @@ Framed thigh_matrix() {
 TEST(FramedCholesky, FrameAroundChangesIsTheChangedRowsAndTheirNeighbours) {
   const Framed f = thigh_matrix();
   const int last = static_cast<int>(f.a.rows()) - 1;
-  int neighbours = 0;  // the row itself among them, interface rows not
-  for (SparseMatrix::InnerIterator it(f.a, last); it; ++it) neighbours += it.index() >= f.frozen;
+  int neighbours = 0;  // the row itself among them
+  for (SparseMatrix::InnerIterator it(f.a, last); it; ++it) ++neighbours;
   EXPECT_EQ(static_cast<int>(f.frame.size()), neighbours);
-  for (int r : f.frame) EXPECT_GE(r, f.frozen);
   EXPECT_TRUE(std::binary_search(f.frame.begin(), f.frame.end(), last));
   ASSERT_GE(f.outside, 0);
+  // A changed interface row joins the frame but does not spread it over the dense block.
+  ASSERT_GT(f.dense, 0);
+  SparseMatrix before = f.a;
+  before.coeffRef(0, 0) *= 2;
+  EXPECT_EQ(FramedCholesky::frame_around_changes(before, f.a, f.dense, 1), std::vector<int>{0});
+  EXPECT_EQ(FramedCholesky::frame_around_changes(before, f.a, 0, 1).size(),
+            static_cast<size_t>(f.a.innerVector(0).nonZeros()));
 }
 
 TEST(FramedCholesky, TakesChangesInsideTheFrameAndNewDofsCoupledToIt) {
