@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace stc {
@@ -150,10 +151,12 @@ Vector HybridModel::loads() const {
   return point_loads_ + gravity_loads(mesh_, elements_.material().density, gravity_);
 }
 
-void HybridModel::rebuild_hybrid_system() {
+void HybridModel::rebuild_hybrid_system(const std::vector<int>* changed,
+                                        const std::vector<Triplet>* removed) {
   // Unknowns: free DOFs of I, then of O (operation nodes still used by a part-1 tet).
   std::vector<int> nodes = partition_.interface;
   nodes.insert(nodes.end(), partition_.operation.begin(), partition_.operation.end());
+  const std::vector<int> old_rows = std::move(dofs_.global_of);
   dofs_ = make_dof_map(mesh_.num_nodes(), nodes, fixed_);
   const DofMap& idofs = condensed_->interface_dofs;
   interface_row_.resize(static_cast<size_t>(idofs.rows()));
@@ -167,8 +170,11 @@ void HybridModel::rebuild_hybrid_system() {
   for (int k = 0; k < idofs.rows(); ++k)
     if (interface_row_[static_cast<size_t>(k)] != k)
       throw std::logic_error("HybridModel: the interface DOFs are not the leading rows");
-  const SparseMatrix k1 = assemble_stiffness(mesh_, elements_, partition_.operation_tets, dofs_);
-  merge_k0(k1, k0_padded_, a_);
+  if (!changed || !removed || !update_hybrid_matrix(old_rows, *changed, *removed)) {
+    const SparseMatrix k1 = assemble_stiffness(mesh_, elements_, partition_.operation_tets, dofs_);
+    merge_k0(k1, k0_padded_, a_);
+    assembled_tets_ = mesh_.tets;
+  }
 
   // Right-hand side: f_O, f_I - g0. The loads of the whole mesh, with part 2's gravity kept
   // from the start (a cut changes part-1 tets only).
@@ -301,6 +307,46 @@ Vec3 HybridModel::reaction_force(const std::vector<int>& nodes) const {
   return sum;
 }
 
+bool HybridModel::update_hybrid_matrix(const std::vector<int>& old_rows,
+                                       const std::vector<int>& changed,
+                                       const std::vector<Triplet>& removed) {
+  // Only when every DOF keeps its row (a cut appends its new nodes' DOFs): then the rows no
+  // changed tet touches stay as they are, bit for bit (section 6.2 relies on it).
+  const int n = dofs_.rows();
+  if (a_.rows() != static_cast<Eigen::Index>(old_rows.size()) || n < a_.rows() ||
+      !std::equal(old_rows.begin(), old_rows.end(), dofs_.global_of.begin()))
+    return false;
+  std::vector<Triplet> delta;
+  delta.reserve(removed.size() + 144 * changed.size());
+  for (const Triplet& t : removed) {
+    const int r = dofs_.row_of[static_cast<size_t>(t.row())];
+    const int c = dofs_.row_of[static_cast<size_t>(t.col())];
+    if (r >= 0 && c >= 0) delta.emplace_back(r, c, t.value());
+  }
+  std::vector<int> operation_changed;
+  for (int t : changed)
+    if (partition_.operation_tet[static_cast<size_t>(t)]) operation_changed.push_back(t);
+  add_element_triplets(mesh_, elements_, operation_changed, dofs_.row_of, dofs_.row_of, delta);
+  std::vector<std::uint8_t> touched(static_cast<size_t>(n), 0);
+  for (const Triplet& t : delta) touched[static_cast<size_t>(t.row())] = 1;
+  SparseMatrix d(n, n);
+  d.setFromTriplets(delta.begin(), delta.end());
+  a_.conservativeResize(n, n);
+  a_ = SparseMatrix(a_ + d);
+  // Couplings the cut removed cancel to rounding (a few ulps of the entries summed), not to
+  // zero: dropped, so a piece the cut severed is not held by a 1e-16 spring (section 8's
+  // singular-factor check would not see it).
+  const Vector diag = a_.diagonal();
+  a_.prune([&](int r, int c, double v) {
+    if (!touched[static_cast<size_t>(r)] || !touched[static_cast<size_t>(c)]) return true;
+    return std::abs(v) > 1e-12 * std::sqrt(std::abs(diag[r] * diag[c]));
+  });
+  assembled_tets_.resize(mesh_.tets.size());
+  for (int t : changed)
+    assembled_tets_[static_cast<size_t>(t)] = mesh_.tets[static_cast<size_t>(t)];
+  return true;
+}
+
 void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
                                         const std::vector<NewNode>& new_nodes) {
   const int old_nodes = static_cast<int>(u_.size() / 3);
@@ -332,6 +378,19 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     }
     point_loads_.segment<3>(3 * node).setZero();
   }
+  // The changed tets' contributions as a_ holds them (their nodes then, their matrices now,
+  // before the update), negated: the new matrix is a_ plus the difference.
+  std::vector<Triplet> removed;
+  for (int t : changed_tets) {
+    if (t >= static_cast<int>(assembled_tets_.size()) ||
+        !partition_.operation_tet[static_cast<size_t>(t)])
+      continue;
+    const Tet& e = assembled_tets_[static_cast<size_t>(t)];
+    const Mat12& k = elements_[t];
+    for (int a = 0; a < 12; ++a)
+      for (int b = 0; b < 12; ++b)
+        removed.emplace_back(3 * e[a / 3] + a % 3, 3 * e[b / 3] + b % 3, -k(a, b));
+  }
   // Only the changed element matrices are recomputed.
   elements_.update(mesh_, changed_tets);
   // Only part 1 changed: the partition is updated from the part-1 tets alone. The condensed
@@ -342,7 +401,7 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
         "HybridModel::update_operation_part: the change reached the "
         "condensed (non-operation) part");
   partition_ = std::move(p);
-  rebuild_hybrid_system();
+  rebuild_hybrid_system(&changed_tets, &removed);
 }
 
 void HybridModel::set_young_modulus(double young_modulus) {

@@ -143,7 +143,14 @@ class HybridModel {
 
  private:
   void condense_and_assemble(std::chrono::steady_clock::time_point start);
-  void rebuild_hybrid_system();
+  // The hybrid system (10) of the current mesh and partition. With `changed` (the tets a cut
+  // changed) and `removed` (their contributions as last assembled, negated, by global DOF), a_
+  // is updated by the difference instead of re-assembled when the DOFs kept their rows.
+  void rebuild_hybrid_system(const std::vector<int>* changed = nullptr,
+                             const std::vector<Triplet>* removed = nullptr);
+  // a_ += the changed tets' new element matrices + `removed`; false if a_ cannot be updated.
+  bool update_hybrid_matrix(const std::vector<int>& old_rows, const std::vector<int>& changed,
+                            const std::vector<Triplet>& removed);
   std::vector<std::uint8_t> held_dofs() const;  // per hybrid row, from held_
 
   TetMesh mesh_;
@@ -161,7 +168,8 @@ class HybridModel {
   DofMap dofs_;                     // hybrid system over free DOFs of O u I
   std::vector<int> interface_row_;  // free interface DOF k -> hybrid row
   SparseMatrix a_;
-  SparseMatrix k0_padded_;  // K0 as a sparse block (3|I|_free square), at the current E
+  std::vector<Tet> assembled_tets_;  // every tet's nodes as a_ holds its element matrix
+  SparseMatrix k0_padded_;           // K0 as a sparse block (3|I|_free square), at the current E
   Vector b_;
   // u_ is mutable for the on-demand recovery of its S and Q entries in displacement().
   mutable Vector u_;
