@@ -85,8 +85,13 @@ std::vector<MeshPiece> face_connected_pieces(const TetMesh& mesh) {
 std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored) {
   // Pieces by shared FACES: a piece that hangs on the rest by a node or an edge only (a
   // hinge: it can rotate about it) has a singular stiffness, so it counts as its own piece.
+  return free_pieces(face_connected_pieces(mesh), mesh, anchored);
+}
+
+std::vector<MeshPiece> free_pieces(std::vector<MeshPiece> pieces, const TetMesh& mesh,
+                                   const std::vector<std::uint8_t>& anchored) {
   std::vector<MeshPiece> free;
-  for (MeshPiece& piece : face_connected_pieces(mesh)) {
+  for (MeshPiece& piece : pieces) {
     // Held in place only by three anchored nodes that are not on one line (one or two
     // would leave it free to rotate).
     std::vector<Vec3> held;

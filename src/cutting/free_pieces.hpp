@@ -13,11 +13,6 @@
 
 namespace stc {
 
-struct MeshPiece {
-  std::vector<int> tets;   // ascending
-  std::vector<int> nodes;  // ascending
-};
-
 // Connected components of the mesh, tets connected when they share a node (a shared face
 // or edge implies a shared node), in order of their smallest tet.
 std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh);
@@ -35,5 +30,8 @@ const MeshPiece* smallest_piece_with_node(std::vector<MeshPiece>&& pieces, int n
 // node or an edge can rotate about it) with fewer than three non-collinear anchored nodes
 // (anchored: per node, e.g. fixed or interface nodes).
 std::vector<MeshPiece> free_pieces(const TetMesh& mesh, const std::vector<std::uint8_t>& anchored);
+// The same for face-connected `pieces` already found (mesh/face_adjacency.hpp).
+std::vector<MeshPiece> free_pieces(std::vector<MeshPiece> pieces, const TetMesh& mesh,
+                                   const std::vector<std::uint8_t>& anchored);
 
 }  // namespace stc

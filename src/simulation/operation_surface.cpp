@@ -25,13 +25,6 @@ TetMesh tet_subset(const TetMesh& mesh, const std::vector<int>& tets) {
   return sub;
 }
 
-BoundarySurface OperationSurface::part1_boundary(const TetMesh& mesh,
-                                                 const std::vector<int>& tets) {
-  BoundarySurface s = extract_boundary_surface(tet_subset(mesh, tets));
-  for (BoundaryTriangle& t : s.triangles) t.tet = tets[static_cast<size_t>(t.tet)];
-  return s;
-}
-
 void OperationSurface::init(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tet) {
   const BoundarySurface full = extract_boundary_surface(mesh);
   condensed_.clear();
@@ -45,7 +38,8 @@ void OperationSurface::init(const TetMesh& mesh, const std::vector<std::uint8_t>
   std::vector<int> part1;
   for (int t = 0; t < mesh.num_tets(); ++t)
     if (operation_tet[static_cast<size_t>(t)]) part1.push_back(t);
-  const BoundarySurface own = part1_boundary(mesh, part1);
+  part1_.build(mesh, part1);
+  const BoundarySurface own = part1_.boundary(mesh);
   // Faces on part 1's own boundary that are not on the tissue's: shared with part 2.
   std::sort(part1_on_boundary.begin(), part1_on_boundary.end());
   shared_.clear();
@@ -56,11 +50,14 @@ void OperationSurface::init(const TetMesh& mesh, const std::vector<std::uint8_t>
   condensed_non_manifold_ = std::max(0, full.non_manifold_faces - own.non_manifold_faces);
 }
 
-BoundarySurface OperationSurface::current(const TetMesh& mesh,
-                                          const std::vector<int>& operation_tets) const {
+void OperationSurface::update(const TetMesh& mesh, const std::vector<int>& changed) {
+  part1_.update(mesh, changed);
+}
+
+BoundarySurface OperationSurface::current(const TetMesh& mesh) const {
   BoundarySurface s;
   s.triangles = condensed_;
-  const BoundarySurface own = part1_boundary(mesh, operation_tets);
+  const BoundarySurface own = part1_.boundary(mesh);
   for (const BoundaryTriangle& t : own.triangles)
     if (!std::binary_search(shared_.begin(), shared_.end(), key(t.nodes))) s.triangles.push_back(t);
   s.non_manifold_faces = condensed_non_manifold_ + own.non_manifold_faces;

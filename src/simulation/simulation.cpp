@@ -291,6 +291,7 @@ struct Simulation::Impl {
     t0 = Clock::now();
     ++mesh_version;
     model->update_operation_part(r.changed_tets, r.new_nodes);
+    boundary.update(model->mesh(), r.changed_tets);
     // A copy of a held node stays held (both halves of a cut held piece stay put).
     for (const NewNode& n : r.new_nodes)
       if (n.kind == NewNode::Kind::kDuplicate)
@@ -335,14 +336,17 @@ struct Simulation::Impl {
   // The operation surface of the current mesh and partition, at the current displacement.
   void rebuild_surface_tree() {
     const Partition& p = model->partition();
-    surface_tree.build(boundary.current(model->mesh(), p.operation_tets), model->mesh(),
-                       p.operation_tet, displacements());
+    surface_tree.build(boundary.current(model->mesh()), model->mesh(), p.operation_tet,
+                       displacements());
   }
 
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where
   // it is.
   void hold_free_pieces() {
-    const std::vector<MeshPiece> pieces = free_pieces(piece_search_mesh(), anchored);
+    // A fixed region: part 1's pieces, from the faces the cuts kept matched (operation_surface).
+    const std::vector<MeshPiece> pieces =
+        follower ? free_pieces(model->mesh(), anchored)
+                 : free_pieces(boundary.part1_pieces(model->mesh()), model->mesh(), anchored);
     for (const MeshPiece& piece : pieces) hold_piece(piece);
     log_pieces_held(pieces);
   }

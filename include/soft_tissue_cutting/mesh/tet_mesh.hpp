@@ -42,4 +42,10 @@ double total_volume(const TetMesh& mesh);
 // equal meshes, equal hashes (replays must agree).
 std::string mesh_hash(const TetMesh& mesh);
 
+// A connected piece of a tet mesh (cutting/free_pieces.hpp, mesh/face_adjacency.hpp).
+struct MeshPiece {
+  std::vector<int> tets;   // ascending
+  std::vector<int> nodes;  // ascending
+};
+
 }  // namespace stc

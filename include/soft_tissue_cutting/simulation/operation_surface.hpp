@@ -1,10 +1,12 @@
 // The tissue's boundary surface after cuts, from the operation part alone (docs/DESIGN.md,
 // per-step cost). Cuts change part 1 only, so the boundary triangles of part-2 tets and the
 // faces shared by the two parts are kept from one whole-mesh extraction; after a cut only the
-// part-1 tets (a few thousand at organ scale, of 70k+) are scanned again.
+// part-1 tets (a few thousand at organ scale, of 70k+) are scanned again, and only the faces of
+// the tets a cut changed are matched again (mesh/face_adjacency.hpp).
 #pragma once
 
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+#include "soft_tissue_cutting/mesh/face_adjacency.hpp"
 
 #include <array>
 #include <cstdint>
@@ -16,13 +18,16 @@ class OperationSurface {
  public:
   // One whole-mesh extraction: operation_tet per tet, nonzero = part 1.
   void init(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tet);
+  // A cut rewrote or appended the tets in `changed` (all of them part 1).
+  void update(const TetMesh& mesh, const std::vector<int>& changed);
   // The whole boundary surface now (same triangles as extract_boundary_surface(mesh), part-2
-  // triangles first). operation_tets: the part-1 tet list.
-  BoundarySurface current(const TetMesh& mesh, const std::vector<int>& operation_tets) const;
+  // triangles first).
+  BoundarySurface current(const TetMesh& mesh) const;
+  // Part 1's face-connected pieces (as face_connected_pieces of the part-1 tets alone).
+  std::vector<MeshPiece> part1_pieces(const TetMesh& mesh) const { return part1_.pieces(mesh); }
 
  private:
-  // Boundary of the part-1 tets alone, tet indices mapped back to the mesh.
-  static BoundarySurface part1_boundary(const TetMesh& mesh, const std::vector<int>& tets);
+  TetFaceAdjacency part1_;  // which part-1 tets share each face
 
   std::vector<BoundaryTriangle> condensed_;  // boundary triangles owned by part-2 tets
   std::vector<std::array<int, 3>> shared_;   // sorted node triples of part 1 / part 2 faces

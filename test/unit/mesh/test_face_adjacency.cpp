@@ -1,0 +1,161 @@
+// TetFaceAdjacency (mesh/face_adjacency.hpp): after every one of hundreds of seeded random
+// sweeps through the thigh's and a TetGen liver's operation part, updated from the tets each
+// sweep changed alone, its boundary is the same set of triangles (nodes, winding, owner, cut
+// flag) and non-manifold count as extract_boundary_surface of the operation tets, and its pieces
+// the same as face_connected_pieces of those tets.
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
+#include "cutting/free_pieces.hpp"
+#include "soft_tissue_cutting/generators/thigh.hpp"
+#include "soft_tissue_cutting/io/mesh_reader.hpp"
+#include "soft_tissue_cutting/mesh/face_adjacency.hpp"
+#include "soft_tissue_cutting/partition/partition.hpp"
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+#include <random>
+#include <tuple>
+
+namespace stc {
+namespace {
+
+using Row = std::tuple<int, int, int, int, int, bool>;  // nodes, tet, face, cut
+
+std::vector<Row> rows_of(const BoundarySurface& s) {
+  std::vector<Row> rows;
+  for (const BoundaryTriangle& t : s.triangles)
+    rows.emplace_back(t.nodes[0], t.nodes[1], t.nodes[2], t.tet, t.face, t.cut);
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+// Checks the adjacency of `members` against the from-scratch extraction.
+void expect_same(const TetFaceAdjacency& adjacency, const TetMesh& mesh,
+                 const std::vector<int>& members, const std::string& where) {
+  BoundarySurface ref = extract_boundary_surface(tet_subset(mesh, members));
+  for (BoundaryTriangle& t : ref.triangles) t.tet = members[static_cast<size_t>(t.tet)];
+  const BoundarySurface got = adjacency.boundary(mesh);
+  ASSERT_EQ(rows_of(got), rows_of(ref)) << where;
+  EXPECT_EQ(got.non_manifold_faces, ref.non_manifold_faces) << where;
+  std::vector<MeshPiece> ref_pieces = face_connected_pieces(tet_subset(mesh, members));
+  for (MeshPiece& p : ref_pieces)
+    for (int& t : p.tets) t = members[static_cast<size_t>(t)];
+  const std::vector<MeshPiece> pieces = adjacency.pieces(mesh);
+  ASSERT_EQ(pieces.size(), ref_pieces.size()) << where;
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    EXPECT_EQ(pieces[k].tets, ref_pieces[k].tets) << where << ", piece " << k;
+    EXPECT_EQ(pieces[k].nodes, ref_pieces[k].nodes) << where << ", piece " << k;
+  }
+}
+
+// `sweeps` random blade sweeps through the scene's operation part, ending in a cut mesh with
+// several pieces; returns how many sweeps changed tets.
+int sweep_and_check(const Scene& scene, unsigned seed, int sweeps) {
+  TetMesh mesh = scene.mesh;
+  const Partition p = partition_mesh(mesh, scene.operation_region);
+  std::vector<std::uint8_t> locked(mesh.nodes.size(), 0);
+  for (int n : p.interface) locked[static_cast<size_t>(n)] = 1;
+  CutState state = make_cut_state(mesh, locked, p.operation_tet);
+  std::vector<int> members = p.operation_tets;
+  TetFaceAdjacency adjacency;
+  adjacency.build(mesh, members);
+  expect_same(adjacency, mesh, members, "uncut");
+  Vec3 lo = Vec3::Constant(1e300), hi = -lo;
+  for (int t : members)
+    for (int v : mesh.tets[static_cast<size_t>(t)])
+      lo = lo.cwiseMin(mesh.nodes[static_cast<size_t>(v)]),
+      hi = hi.cwiseMax(mesh.nodes[static_cast<size_t>(v)]);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto point = [&] { return Vec3(lo + (hi - lo).cwiseProduct(Vec3(u(rng), u(rng), u(rng)))); };
+  const double length = 0.5 * (hi - lo).minCoeff();
+  int changed = 0;
+  for (int k = 0; k < sweeps; ++k) {
+    BladeEdge from, to;
+    from.tip = point();
+    const Vec3 edge = (point() - point()).normalized() * length;
+    const Vec3 move = (point() - point()).normalized() * 0.3 * length;
+    from.heel = from.tip + edge;
+    to.tip = from.tip + move;
+    to.heel = from.heel + move;
+    from.normal = to.normal = edge.cross(move).normalized();
+    const CutResult r = cut_sweep(mesh, state, from, to);
+    if (r.changed_tets.empty()) continue;
+    ++changed;
+    adjacency.update(mesh, r.changed_tets);
+    for (int t : r.changed_tets)
+      if (!std::binary_search(members.begin(), members.end(), t)) members.push_back(t);
+    std::sort(members.begin(), members.end());
+    expect_same(adjacency, mesh, members, "sweep " + std::to_string(k));
+    if (::testing::Test::HasFatalFailure()) return changed;
+  }
+  std::printf(
+      "[ adjacency] %d of %d sweeps changed tets: %d -> %zu part-1 tets, %zu pieces, %zu "
+      "boundary triangles\n",
+      changed, sweeps, static_cast<int>(p.operation_tets.size()), members.size(),
+      adjacency.pieces(mesh).size(), adjacency.boundary(mesh).triangles.size());
+  return changed;
+}
+
+TEST(TetFaceAdjacency, FollowsRandomSweepsThroughTheThigh) {
+  EXPECT_GE(sweep_and_check(make_thigh_scene(), 11u, 150), 40);
+}
+
+TEST(TetFaceAdjacency, FollowsRandomSweepsThroughATetgenLiver) {
+  Scene s;
+  MeshReadOptions options;
+  options.tetgen_switches = "pq1.4/10Q";
+  s.mesh = read_mesh(std::string(TISSUE_SHARED_MESH_DIR) + "/sofa_liver2.obj", options);
+  Vec3 lo = s.mesh.nodes[0], hi = lo;
+  for (const Vec3& x : s.mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  s.operation_region.kind = OperationRegion::Kind::kSphere;
+  s.operation_region.sphere = Sphere{0.5 * (lo + hi), 0.3 * (hi - lo).maxCoeff()};
+  EXPECT_GE(sweep_and_check(s, 5u, 150), 40);
+}
+
+// Sweeps across the whole of a box with no interface: the first severs it in two, the second
+// severs more (three pieces: one half is held together by what the cut leaves); the pieces
+// follow.
+TEST(TetFaceAdjacency, FollowsSweepsThatSeverPieces) {
+  GeneratorParams g;
+  g.size = Vec3(0.04, 0.03, 0.02);
+  g.cells = {8, 6, 4};
+  TetMesh mesh = make_box_mesh(g);
+  std::vector<int> members(static_cast<size_t>(mesh.num_tets()));
+  std::iota(members.begin(), members.end(), 0);
+  std::vector<std::uint8_t> locked(mesh.nodes.size(), 0), cuttable(members.size(), 1);
+  CutState state = make_cut_state(mesh, locked, cuttable);
+  TetFaceAdjacency adjacency;
+  adjacency.build(mesh, members);
+  ASSERT_EQ(adjacency.pieces(mesh).size(), 1u);
+  // A blade longer than the box, drawn through all of it: x = 0.0213, then y = 0.0137.
+  const std::vector<std::array<Vec3, 2>> planes = {
+      {Vec3(0.0213, -0.01, -0.01), Vec3(0.0213, 0.04, -0.01)},
+      {Vec3(-0.01, 0.0137, -0.01), Vec3(0.05, 0.0137, -0.01)}};
+  size_t before = 1;
+  for (const auto& [tip, heel] : planes) {
+    BladeEdge from, to;
+    from.tip = tip;
+    from.heel = heel;
+    to.tip = tip + Vec3(0, 0, 0.04);
+    to.heel = heel + Vec3(0, 0, 0.04);
+    from.normal = to.normal = (heel - tip).cross(Vec3(0, 0, 1)).normalized();
+    const CutResult r = cut_sweep(mesh, state, from, to);
+    ASSERT_FALSE(r.changed_tets.empty());
+    adjacency.update(mesh, r.changed_tets);
+    for (int t : r.changed_tets)
+      if (!std::binary_search(members.begin(), members.end(), t)) members.push_back(t);
+    std::sort(members.begin(), members.end());
+    expect_same(adjacency, mesh, members, "plane " + std::to_string(before));
+    const size_t now = adjacency.pieces(mesh).size();
+    EXPECT_GT(now, before);
+    before = now;
+  }
+}
+
+}  // namespace
+}  // namespace stc
