@@ -13,10 +13,10 @@ std::array<double, 4> barycentric(const Vec3& a, const Vec3& b, const Vec3& c, c
           signed_volume(a, b, p, d) / v, signed_volume(a, b, c, p) / v};
 }
 
-void TetLocator::build(const TetMesh& mesh, const std::vector<Vec3>& positions,
+void TetLocator::build(const TetMesh& mesh, std::vector<Vec3> positions,
                        const std::vector<std::uint8_t>& include) {
   mesh_ = &mesh;
-  positions_ = positions;
+  positions_ = std::move(positions);
   tets_.clear();
   std::vector<Box3> boxes;
   for (int t = 0; t < mesh.num_tets(); ++t) {

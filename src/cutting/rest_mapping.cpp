@@ -7,11 +7,18 @@ namespace stc {
 
 void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
                            const std::vector<std::uint8_t>& include) {
+  // Only the included tets are kept (the operation part: a few thousand of the organ's 70k).
   mesh_.nodes = mesh.nodes;
-  mesh_.tets = mesh.tets;
+  mesh_.tets.clear();
+  if (include.empty()) {
+    mesh_.tets = mesh.tets;
+  } else {
+    for (size_t t = 0; t < mesh.tets.size(); ++t)
+      if (include[t]) mesh_.tets.push_back(mesh.tets[t]);
+  }
   std::vector<Vec3> x(mesh.nodes.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = mesh.nodes[i] + displacement[i];
-  locator_.build(mesh_, x, include);
+  locator_.build(mesh_, std::move(x));
 }
 
 namespace {

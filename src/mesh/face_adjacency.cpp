@@ -140,11 +140,17 @@ std::vector<MeshPiece> TetFaceAdjacency::pieces(const TetMesh& mesh) const {
     pieces[static_cast<size_t>(piece_of_root[static_cast<size_t>(root)])].tets.push_back(
         static_cast<int>(t));
   }
-  for (MeshPiece& piece : pieces) {
+  // Each piece's nodes once (a node on a hinge is in each of its pieces), then sorted.
+  std::vector<int> last_piece(mesh.nodes.size(), -1);
+  for (size_t k = 0; k < pieces.size(); ++k) {
+    MeshPiece& piece = pieces[k];
     for (int t : piece.tets)
-      for (int v : mesh.tets[static_cast<size_t>(t)]) piece.nodes.push_back(v);
+      for (int v : mesh.tets[static_cast<size_t>(t)])
+        if (last_piece[static_cast<size_t>(v)] != static_cast<int>(k)) {
+          last_piece[static_cast<size_t>(v)] = static_cast<int>(k);
+          piece.nodes.push_back(v);
+        }
     std::sort(piece.nodes.begin(), piece.nodes.end());
-    piece.nodes.erase(std::unique(piece.nodes.begin(), piece.nodes.end()), piece.nodes.end());
   }
   return pieces;
 }

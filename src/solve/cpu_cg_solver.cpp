@@ -86,7 +86,7 @@ class CpuCgSolver final : public LinearSolver {
   int singular_dof() const override {
     if (!factor_failed_) return -1;
     if (!singular_dof_) {
-      const int c = SparseCholesky::first_failing_column(factored_block());
+      const int c = SparseCholesky::first_failing_column(block());
       singular_dof_ = c < 0 || kept_.empty() ? c : kept_[static_cast<size_t>(c)];
     }
     return *singular_dof_;
@@ -103,6 +103,8 @@ class CpuCgSolver final : public LinearSolver {
     const auto t0 = std::chrono::steady_clock::now();
     const Vector old_held_mask = held_mask_;
     const Eigen::Index old_rows = a_.rows();
+    // The last factored block, moved out (what the next frame is chosen against).
+    SparseMatrix previous = kept_.empty() ? std::move(a_) : std::move(kept_block_);
     a_ = a;
     kept_.clear();
     held_mask_ = Vector::Zero(a_.rows());
@@ -120,6 +122,7 @@ class CpuCgSolver final : public LinearSolver {
     kept_index_.assign(kept_.empty() ? 0 : static_cast<size_t>(a_.rows()), -1);
     for (size_t i = 0; i < kept_.size(); ++i)
       kept_index_[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
+    kept_block_ = kept_.empty() ? SparseMatrix() : kept_block_of(a_);
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -131,7 +134,7 @@ class CpuCgSolver final : public LinearSolver {
     const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
                            held_mask_.head(old_rows) == old_held_mask;
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.interface_rows);
+      factor(same_rows, history.interface_rows, previous);
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -276,16 +279,18 @@ class CpuCgSolver final : public LinearSolver {
 
  private:
   // The matrix to factor: A, or A_kk without the held DOFs.
-  SparseMatrix factored_block() const {
-    if (kept_.empty()) return a_;
+  const SparseMatrix& block() const { return kept_.empty() ? a_ : kept_block_; }
+
+  // A_kk of `a` (kept_ set).
+  SparseMatrix kept_block_of(const SparseMatrix& a) const {
     // Row by row in kept order: the renumbering is increasing, so each row's columns stay
     // sorted and the compressed arrays are written directly (no triplets, no sort).
     const auto n = static_cast<Eigen::Index>(kept_.size());
     SparseMatrix out(n, n);
-    out.reserve(a_.nonZeros());
+    out.reserve(a.nonZeros());
     for (Eigen::Index i = 0; i < n; ++i) {
       out.startVec(i);
-      for (SparseMatrix::InnerIterator it(a_, kept_[static_cast<size_t>(i)]); it; ++it) {
+      for (SparseMatrix::InnerIterator it(a, kept_[static_cast<size_t>(i)]); it; ++it) {
         const int j = kept_index_[static_cast<size_t>(it.index())];
         if (j >= 0) out.insertBack(i, j) = it.value();
       }
@@ -297,29 +302,28 @@ class CpuCgSolver final : public LinearSolver {
   // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
   // active. same_rows: the block's leading rows are the last block's DOFs, so the last factor
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
-  // keeps a frame around what changed; its first `interface` rows are the dense interface block.
-  void factor(bool same_rows, int interface) {
-    SparseMatrix block = factored_block();
+  // keeps a frame around what changed since `previous` (the last block); its first `interface`
+  // rows are the dense interface block.
+  void factor(bool same_rows, int interface, const SparseMatrix& previous) {
+    const SparseMatrix& block = this->block();
     if (block.rows() == 0) {
       chol_.reset();
-      last_block_ = SparseMatrix();
       active_ = "jacobi";
       return;
     }
     if (same_rows && active_ == "cholesky" && chol_->update(block)) {
       if (chol_->frame_size() <= kMaxFrame) {
-        last_block_ = std::move(block);
         ++frame_updates_;
         return;
       }
     }
     std::vector<int> frame;
-    if (same_rows && last_block_.rows() > 0 && last_block_.rows() <= block.rows()) {
+    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows()) {
       int dense = interface;
       if (!kept_.empty())
         dense = static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) -
                                  kept_.begin());
-      frame = FramedCholesky::frame_around_changes(last_block_, block, dense, kFrameRings);
+      frame = FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
       if (static_cast<int>(frame.size()) > kMaxFrame) frame.clear();
     }
     chol_.reset();
@@ -327,11 +331,9 @@ class CpuCgSolver final : public LinearSolver {
     try {
       chol_ = std::make_unique<FramedCholesky>(block, frame);
       active_ = "cholesky";
-      last_block_ = std::move(block);
       return;
     } catch (const std::runtime_error&) {
       factor_failed_ = true;
-      last_block_ = SparseMatrix();
     }
     SparseMatrix shifted = block;
     const double dmax = block.diagonal().cwiseAbs().maxCoeff();
@@ -351,7 +353,7 @@ class CpuCgSolver final : public LinearSolver {
   SparseMatrix a_;
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
-  SparseMatrix last_block_;  // the block chol_ was last set up for (what the next cut changes)
+  SparseMatrix kept_block_;  // A_kk when some DOFs are held (else the block is a_ itself)
   // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -23,7 +24,7 @@ struct TetLocation {
 class TetLocator {
  public:
   // positions: per node (e.g. rest + u); include: per tet, nonzero = searched (empty = all).
-  void build(const TetMesh& mesh, const std::vector<Vec3>& positions,
+  void build(const TetMesh& mesh, std::vector<Vec3> positions,
              const std::vector<std::uint8_t>& include = {});
   // The tet containing p (barycentric slack `tolerance`, relative), or nothing outside.
   // Of several (p on a shared face), the one with the largest smallest weight.
