@@ -171,6 +171,7 @@ void HybridModel::rebuild_hybrid_system(const std::vector<int>* changed,
     if (interface_row_[static_cast<size_t>(k)] != k)
       throw std::logic_error("HybridModel: the interface DOFs are not the leading rows");
   if (!changed || !removed || !update_hybrid_matrix(old_rows, *changed, *removed)) {
+    rows_changed_.reset();  // any row may have changed
     const SparseMatrix k1 = assemble_stiffness(mesh_, elements_, partition_.operation_tets, dofs_);
     merge_k0(k1, k0_padded_, a_);
     assembled_tets_ = mesh_.tets;
@@ -198,8 +199,10 @@ void HybridModel::refresh_factor() const {
                                     now.begin() + std::min(now.size(), solver_dofs_.size()));
   history.kept_rows = static_cast<int>(common.first - solver_dofs_.begin());
   history.interface_rows = static_cast<int>(interface_row_.size());  // the leading rows
+  if (rows_changed_) history.changed_rows = &*rows_changed_;
   solver_->set_matrix(a_, held_dofs(), history);
   solver_dofs_ = now;
+  rows_changed_.emplace();  // from here on, every change is listed (update_hybrid_matrix)
   factor_stale_ = false;
 }
 
@@ -329,6 +332,9 @@ bool HybridModel::update_hybrid_matrix(const std::vector<int>& old_rows,
   add_element_triplets(mesh_, elements_, operation_changed, dofs_.row_of, dofs_.row_of, delta);
   std::vector<std::uint8_t> touched(static_cast<size_t>(n), 0);
   for (const Triplet& t : delta) touched[static_cast<size_t>(t.row())] = 1;
+  if (rows_changed_)
+    for (int r = 0; r < n; ++r)
+      if (touched[static_cast<size_t>(r)] || r >= a_.rows()) rows_changed_->push_back(r);
   SparseMatrix d(n, n);
   d.setFromTriplets(delta.begin(), delta.end());
   // One pass into the new arrays: an untouched row is copied as it is (the dense interface

@@ -133,8 +133,17 @@ class CpuCgSolver final : public LinearSolver {
     // them changed its held state: then a cut within the last frame refactors the frame alone.
     const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
                            held_mask_.head(old_rows) == old_held_mask;
+    // The rows changed since the factorization, in the block's numbering, when known.
+    std::optional<std::vector<int>> changed;
+    if (same_rows && history.changed_rows) {
+      changed.emplace();
+      for (int r : *history.changed_rows) {
+        const int k = kept_.empty() ? r : kept_index_[static_cast<size_t>(r)];
+        if (k >= 0) changed->push_back(k);
+      }
+    }
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.interface_rows, previous);
+      factor(same_rows, history.interface_rows, previous, changed);
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -304,14 +313,21 @@ class CpuCgSolver final : public LinearSolver {
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
   // keeps a frame around what changed since `previous` (the last block); its first `interface`
   // rows are the dense interface block.
-  void factor(bool same_rows, int interface, const SparseMatrix& previous) {
+  void factor(bool same_rows, int interface, const SparseMatrix& previous,
+              const std::optional<std::vector<int>>& changed) {
     const SparseMatrix& block = this->block();
     if (block.rows() == 0) {
       chol_.reset();
       active_ = "jacobi";
       return;
     }
-    if (same_rows && active_ == "cholesky" && chol_->update(block)) {
+    // Every row changed since the factorization: this change's, and the earlier updates'.
+    if (changed && changed_since_factor_)
+      changed_since_factor_->insert(changed_since_factor_->end(), changed->begin(), changed->end());
+    else
+      changed_since_factor_.reset();
+    if (same_rows && active_ == "cholesky" &&
+        chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr)) {
       if (chol_->frame_size() <= kMaxFrame) {
         ++frame_updates_;
         return;
@@ -323,7 +339,8 @@ class CpuCgSolver final : public LinearSolver {
       if (!kept_.empty())
         dense = static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) -
                                  kept_.begin());
-      frame = FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
+      frame = changed ? FramedCholesky::frame_around(block, *changed, dense, kFrameRings)
+                      : FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
       if (static_cast<int>(frame.size()) > kMaxFrame) frame.clear();
     }
     chol_.reset();
@@ -331,6 +348,7 @@ class CpuCgSolver final : public LinearSolver {
     try {
       chol_ = std::make_unique<FramedCholesky>(block, frame);
       active_ = "cholesky";
+      changed_since_factor_.emplace();
       return;
     } catch (const std::runtime_error&) {
       factor_failed_ = true;
@@ -354,6 +372,8 @@ class CpuCgSolver final : public LinearSolver {
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
   SparseMatrix kept_block_;  // A_kk when some DOFs are held (else the block is a_ itself)
+  // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
+  std::optional<std::vector<int>> changed_since_factor_;
   // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;

@@ -200,13 +200,18 @@ FramedCholesky::~FramedCholesky() = default;
 
 int FramedCholesky::factored_rows() const { return static_cast<int>(impl_->factored.rows()); }
 
-bool FramedCholesky::update(const SparseMatrix& a) {
+bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* changed) {
   Impl& m = *impl_;
   const int n_old = static_cast<int>(m.factored.rows());
   const int n = static_cast<int>(a.rows());
   if (n < n_old || m.factor == nullptr) return false;
-  for (int r = 0; r < n_old; ++r)
-    if (!m.in_old_frame[static_cast<size_t>(r)] && !same_row(a, m.factored, r)) return false;
+  if (changed) {
+    for (int r : *changed)
+      if (r < 0 || r >= n || (r < n_old && !m.in_old_frame[static_cast<size_t>(r)])) return false;
+  } else {
+    for (int r = 0; r < n_old; ++r)
+      if (!m.in_old_frame[static_cast<size_t>(r)] && !same_row(a, m.factored, r)) return false;
+  }
   // The frame: the old one in its elimination order, then the new DOFs.
   const int nb_old = n_old - m.n_f, nb = nb_old + (n - n_old);
   std::vector<int> frame(frame_.begin(), frame_.begin() + nb_old);
@@ -279,13 +284,23 @@ Vector FramedCholesky::solve(const Vector& b) const { return solve(Eigen::Matrix
 std::vector<int> FramedCholesky::frame_around_changes(const SparseMatrix& previous,
                                                       const SparseMatrix& a, int dense, int rings) {
   const int n = static_cast<int>(a.rows()), n_old = static_cast<int>(previous.rows());
+  std::vector<int> changed;
+  for (int r = 0; r < n; ++r)
+    if (r >= n_old || !same_row(a, previous, r)) changed.push_back(r);
+  return frame_around(a, changed, dense, rings);
+}
+
+std::vector<int> FramedCholesky::frame_around(const SparseMatrix& a,
+                                              const std::vector<int>& changed, int dense,
+                                              int rings) {
+  const int n = static_cast<int>(a.rows());
   std::vector<char> in(static_cast<size_t>(n), 0);
   std::vector<int> layer;
-  for (int r = 0; r < n; ++r)
-    if (r >= n_old || !same_row(a, previous, r)) {
-      in[static_cast<size_t>(r)] = 1;
-      if (r >= dense) layer.push_back(r);
-    }
+  for (int r : changed) {
+    if (r < 0 || r >= n || in[static_cast<size_t>(r)]) continue;
+    in[static_cast<size_t>(r)] = 1;
+    if (r >= dense) layer.push_back(r);
+  }
   for (int ring = 0; ring < rings && !layer.empty(); ++ring) {
     std::vector<int> next;
     for (int r : layer)

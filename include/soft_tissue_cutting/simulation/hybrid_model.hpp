@@ -21,6 +21,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -182,6 +183,9 @@ class HybridModel {
   // The DOFs (global_of) of the matrix the solver last saw: a cut keeps them and appends its
   // new nodes', so the solver may refactor only what changed (LinearSolver::History).
   mutable std::vector<int> solver_dofs_;
+  // The rows a_ changed in since the solver last saw it (cuts' matrix updates); none: unknown
+  // (a full assembly), the solver compares.
+  mutable std::optional<std::vector<int>> rows_changed_;
   void refresh_factor() const;
   ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;

@@ -39,7 +39,9 @@ class FramedCholesky final : public CholeskySolve {
   // DOFs as the factored matrix's, every row outside the frame is unchanged (pattern and values),
   // and the frame's Schur complement is positive definite. Rows beyond rows() are new DOFs and
   // join the frame. Returns false, leaving this factor as it was, otherwise.
-  bool update(const SparseMatrix& a);
+  // `changed`, when given, lists every row in which `a` may differ from the factored matrix
+  // (the others are taken as equal, not compared).
+  bool update(const SparseMatrix& a, const std::vector<int>* changed = nullptr);
 
   Vector solve(const Vector& b) const override;
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const override;
@@ -55,6 +57,9 @@ class FramedCholesky final : public CholeskySolve {
   // block, where each row neighbours all the others) join it but never grow it.
   static std::vector<int> frame_around_changes(const SparseMatrix& previous, const SparseMatrix& a,
                                                int dense, int rings);
+  // The same around rows known to have changed.
+  static std::vector<int> frame_around(const SparseMatrix& a, const std::vector<int>& changed,
+                                       int dense, int rings);
 
  private:
   struct Impl;

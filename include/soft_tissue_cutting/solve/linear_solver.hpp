@@ -73,9 +73,12 @@ class LinearSolver {
   // same DOFs as the last matrix's (a cut appends the DOFs of its new nodes), and its first
   // `interface_rows` rows are the dense interface block (docs/DESIGN.md section 4). A solver
   // may then refactor only what changed (cpu_cg_solver.cpp). Default: set_matrix(a, held).
+  // `changed_rows`, when given, lists every row that may differ from the last matrix's (the
+  // others are bit for bit the same): the solver need not compare them.
   struct History {
     int kept_rows = 0;
     int interface_rows = 0;
+    const std::vector<int>* changed_rows = nullptr;
   };
   virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                           const History& history) {

@@ -185,6 +185,25 @@ TEST(FramedCholesky, TakesChangesInsideTheFrameAndNewDofsCoupledToIt) {
   EXPECT_LE(relative(factor.solve(b2), SparseCholesky(grown).solve(b2)), 1e-12);
 }
 
+// With the changed rows named (what the hybrid model knows after a cut), rows outside the list
+// are not compared: a list inside the frame is taken, one with a row outside refused.
+TEST(FramedCholesky, TakesTheChangedRowsItIsTold) {
+  const Framed f = thigh_matrix();
+  FramedCholesky factor(f.a, f.frame);
+  SparseMatrix changed = f.a;
+  const int p = f.frame[0];
+  changed.coeffRef(p, p) *= 1.25;
+  const std::vector<int> outside = {p, f.outside};
+  EXPECT_FALSE(factor.update(changed, &outside));
+  EXPECT_EQ(factor.updates(), 0);
+  const std::vector<int> inside = {p};
+  ASSERT_TRUE(factor.update(changed, &inside));
+  const Vector b = Vector::LinSpaced(f.a.rows(), 1.0, 2.0);
+  EXPECT_LE(relative(factor.solve(b), SparseCholesky(changed).solve(b)), 1e-12);
+  EXPECT_EQ(FramedCholesky::frame_around(f.a, {static_cast<int>(f.a.rows()) - 1}, f.dense, 1),
+            f.frame);
+}
+
 TEST(FramedCholesky, RefusesChangesOutsideTheFrameAndKeepsItsFactor) {
   const Framed f = thigh_matrix();
   FramedCholesky factor(f.a, f.frame);
