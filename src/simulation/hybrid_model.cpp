@@ -350,7 +350,10 @@ bool HybridModel::update_hybrid_matrix(const std::vector<int>& old_rows,
     return touched[static_cast<size_t>(c)] &&
            std::abs(v) <= 1e-12 * std::sqrt(std::abs(diag[r] * diag[c]));
   };
-  SparseMatrix out(n, n);
+  // Written into the spare matrix (its arrays kept from the last cut: 5 MB at organ scale
+  // would be fresh pages every time), then swapped in.
+  SparseMatrix& out = spare_;
+  out.resize(n, n);
   out.resizeNonZeros(a_.nonZeros() + d.nonZeros());
   int* outer = out.outerIndexPtr();
   int* inner = out.innerIndexPtr();
@@ -384,7 +387,7 @@ bool HybridModel::update_hybrid_matrix(const std::vector<int>& old_rows,
   }
   outer[n] = k;
   out.resizeNonZeros(k);
-  a_ = std::move(out);
+  a_.swap(out);
   assembled_tets_.resize(mesh_.tets.size());
   for (int t : changed)
     assembled_tets_[static_cast<size_t>(t)] = mesh_.tets[static_cast<size_t>(t)];

@@ -47,6 +47,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -104,7 +105,9 @@ class CpuCgSolver final : public LinearSolver {
     const Vector old_held_mask = held_mask_;
     const Eigen::Index old_rows = a_.rows();
     // The last factored block, moved out (what the next frame is chosen against).
-    SparseMatrix previous = kept_.empty() ? std::move(a_) : std::move(kept_block_);
+    // (Swapped, not copied: the arrays of the one before are reused for the new matrix.)
+    SparseMatrix& previous = previous_;
+    previous.swap(kept_.empty() ? a_ : kept_block_);
     a_ = a;
     kept_.clear();
     held_mask_ = Vector::Zero(a_.rows());
@@ -127,6 +130,9 @@ class CpuCgSolver final : public LinearSolver {
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
     held_.reset();
+    // Rows a cut changed: the last solution does not solve the new system (a new model from a
+    // region move, or new held DOFs, may well be solved by it: the warm start is checked).
+    matrix_is_new_ = history.changed_rows && !history.changed_rows->empty();
     factor_failed_ = false;
     singular_dof_.reset();
     // The kept block's rows are the same DOFs as before when the matrix's are and no DOF of
@@ -197,7 +203,9 @@ class CpuCgSolver final : public LinearSolver {
     // kept DOFs (a press after a cut freed pieces: 9 iterations, 5.5 ms on the organ liver).
     const bool kept_direct = !kept_.empty() && held_mask_.cwiseProduct(free_mask).isZero(0);
     if (chol_ && (kept_.empty() || kept_direct) && settings.max_iterations > 0) {
-      const double warm = (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
+      // A cut's matrix is not solved by the last solution: no product to find out.
+      const double warm = matrix_is_new_ ? std::numeric_limits<double>::infinity()
+                                         : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
       if (warm > settings.tolerance) {
         Vector direct = x;
         if (kept_.empty()) {
@@ -213,6 +221,7 @@ class CpuCgSolver final : public LinearSolver {
           direct(kept_) = xk;
         }
         result.iterations = 1;
+        matrix_is_new_ = false;
         const double res = (b - a_ * direct).cwiseProduct(free_mask).norm() / rhs_norm;
         if (res < warm) x = std::move(direct);
         result.residual = std::min(res, warm);
@@ -374,6 +383,8 @@ class CpuCgSolver final : public LinearSolver {
   SparseMatrix kept_block_;  // A_kk when some DOFs are held (else the block is a_ itself)
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
+  SparseMatrix previous_;       // the block before the last set_matrix (its arrays reused)
+  bool matrix_is_new_ = false;  // set_matrix since the last direct step
   // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;

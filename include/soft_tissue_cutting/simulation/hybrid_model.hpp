@@ -169,6 +169,7 @@ class HybridModel {
   DofMap dofs_;                     // hybrid system over free DOFs of O u I
   std::vector<int> interface_row_;  // free interface DOF k -> hybrid row
   SparseMatrix a_;
+  SparseMatrix spare_;               // the last a_, whose arrays the next cut's update reuses
   std::vector<Tet> assembled_tets_;  // every tet's nodes as a_ holds its element matrix
   SparseMatrix k0_padded_;           // K0 as a sparse block (3|I|_free square), at the current E
   Vector b_;
