@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/assembly/global_assembly.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace stc {
 namespace {
@@ -121,6 +122,57 @@ SparseMatrix assemble_block(const TetMesh& mesh, const ElementStiffnessCache& el
   SparseMatrix k(map_rows.rows(), map_cols.rows());
   k.setFromTriplets(triplets.begin(), triplets.end());  // duplicates are summed
   return k;
+}
+
+void add_difference(SparseMatrix& a, const SparseMatrix& d,
+                    const std::vector<std::uint8_t>& touched, double drop, SparseMatrix& spare) {
+  const int n = static_cast<int>(d.rows()), n_old = static_cast<int>(a.rows());
+  Vector diag = Vector::Zero(n);
+  diag.head(n_old) = a.diagonal();
+  diag += d.diagonal();
+  const auto cancelled = [&](int r, int c, double v) {
+    return touched[static_cast<size_t>(c)] &&
+           std::abs(v) <= drop * std::sqrt(std::abs(diag[r] * diag[c]));
+  };
+  spare.resize(n, n);
+  spare.resizeNonZeros(a.nonZeros() + d.nonZeros());
+  int* outer = spare.outerIndexPtr();
+  int* inner = spare.innerIndexPtr();
+  double* value = spare.valuePtr();
+  const int* ai = a.innerIndexPtr();
+  const double* av = a.valuePtr();
+  const int* di = d.innerIndexPtr();
+  const double* dv = d.valuePtr();
+  int k = 0;
+  for (int r = 0; r < n; ++r) {
+    outer[r] = k;
+    const int a0 = r < n_old ? a.outerIndexPtr()[r] : 0;
+    const int a1 = r < n_old ? a.outerIndexPtr()[r + 1] : 0;
+    if (!touched[static_cast<size_t>(r)]) {  // the dense interface rows, most entries: in bulk
+      std::copy(ai + a0, ai + a1, inner + k);
+      std::copy(av + a0, av + a1, value + k);
+      k += a1 - a0;
+      continue;
+    }
+    int i = a0, j = d.outerIndexPtr()[r];
+    const int j1 = d.outerIndexPtr()[r + 1];
+    while (i < a1 || j < j1) {
+      int c;
+      double v;
+      if (j >= j1 || (i < a1 && ai[i] < di[j])) {
+        c = ai[i], v = av[i++];
+      } else if (i >= a1 || di[j] < ai[i]) {
+        c = di[j], v = dv[j++];
+      } else {
+        c = ai[i], v = av[i++] + dv[j++];
+      }
+      if (cancelled(r, c, v)) continue;
+      inner[k] = c, value[k++] = v;
+    }
+  }
+  outer[n] = k;
+  spare.resizeNonZeros(k);
+  a.swap(spare);
 }
 
 DofMap make_dof_map(int num_nodes, const std::vector<int>& nodes,

@@ -337,57 +337,9 @@ bool HybridModel::update_hybrid_matrix(const std::vector<int>& old_rows,
       if (touched[static_cast<size_t>(r)] || r >= a_.rows()) rows_changed_->push_back(r);
   SparseMatrix d(n, n);
   d.setFromTriplets(delta.begin(), delta.end());
-  // One pass into the new arrays: an untouched row is copied as it is (the dense interface
-  // rows, most of the entries, in bulk), a touched one merged with its difference. Couplings
-  // the cut removed cancel to rounding (a few ulps of the entries summed), not to zero: they
-  // are dropped, so a piece the cut severed is not held by a 1e-16 spring (the singular-factor
-  // check of section 6 would not see it).
-  const int n_old = static_cast<int>(a_.rows());
-  Vector diag = Vector::Zero(n);
-  diag.head(n_old) = a_.diagonal();
-  diag += d.diagonal();
-  const auto removed_coupling = [&](int r, int c, double v) {
-    return touched[static_cast<size_t>(c)] &&
-           std::abs(v) <= 1e-12 * std::sqrt(std::abs(diag[r] * diag[c]));
-  };
-  // Written into the spare matrix (its arrays kept from the last cut: 5 MB at organ scale
-  // would be fresh pages every time), then swapped in.
-  SparseMatrix& out = spare_;
-  out.resize(n, n);
-  out.resizeNonZeros(a_.nonZeros() + d.nonZeros());
-  int* outer = out.outerIndexPtr();
-  int* inner = out.innerIndexPtr();
-  double* value = out.valuePtr();
-  int k = 0;
-  for (int r = 0; r < n; ++r) {
-    outer[r] = k;
-    const int a0 = r < n_old ? a_.outerIndexPtr()[r] : 0;
-    const int a1 = r < n_old ? a_.outerIndexPtr()[r + 1] : 0;
-    if (!touched[static_cast<size_t>(r)]) {
-      std::copy(a_.innerIndexPtr() + a0, a_.innerIndexPtr() + a1, inner + k);
-      std::copy(a_.valuePtr() + a0, a_.valuePtr() + a1, value + k);
-      k += a1 - a0;
-      continue;
-    }
-    int i = a0, j = d.outerIndexPtr()[r];
-    const int j1 = d.outerIndexPtr()[r + 1];
-    while (i < a1 || j < j1) {
-      int c;
-      double v;
-      if (j >= j1 || (i < a1 && a_.innerIndexPtr()[i] < d.innerIndexPtr()[j])) {
-        c = a_.innerIndexPtr()[i], v = a_.valuePtr()[i++];
-      } else if (i >= a1 || d.innerIndexPtr()[j] < a_.innerIndexPtr()[i]) {
-        c = d.innerIndexPtr()[j], v = d.valuePtr()[j++];
-      } else {
-        c = a_.innerIndexPtr()[i], v = a_.valuePtr()[i++] + d.valuePtr()[j++];
-      }
-      if (removed_coupling(r, c, v)) continue;
-      inner[k] = c, value[k++] = v;
-    }
-  }
-  outer[n] = k;
-  out.resizeNonZeros(k);
-  a_.swap(out);
+  // Couplings the cut removed are dropped, so a piece it severed is not held by a 1e-16 spring
+  // (the singular-factor check of section 6 would not see it).
+  add_difference(a_, d, touched, 1e-12, spare_);
   assembled_tets_.resize(mesh_.tets.size());
   for (int t : changed)
     assembled_tets_[static_cast<size_t>(t)] = mesh_.tets[static_cast<size_t>(t)];

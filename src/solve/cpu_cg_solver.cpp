@@ -62,9 +62,9 @@ constexpr double kShift = 1e-9;
 
 // The frame a factorization after a cut keeps for the next cuts (framed_cholesky.hpp): the
 // rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
-// the same tets or their neighbours; two rings took 21 of 31 organ cuts instead of 18 but
-// doubled the frame's cost), and at most kMaxFrame DOFs: the frame's dense Schur complement
-// costs |B|^3/3 per cut (a change of E changes every row: no frame).
+// the same tets or their neighbours: 22 of the organ stroke's 31 cuts fall inside; two rings
+// took hardly more and doubled the frame's cost), and at most kMaxFrame DOFs: the frame's
+// dense Schur complement costs |B|^3/3 per cut (a change of E changes every row: no frame).
 constexpr int kFrameRings = 1;
 constexpr int kMaxFrame = 900;
 
@@ -104,8 +104,8 @@ class CpuCgSolver final : public LinearSolver {
     const auto t0 = std::chrono::steady_clock::now();
     const Vector old_held_mask = held_mask_;
     const Eigen::Index old_rows = a_.rows();
-    // The last factored block, moved out (what the next frame is chosen against).
-    // (Swapped, not copied: the arrays of the one before are reused for the new matrix.)
+    // The last factored block, kept (what the next frame is chosen against): swapped, not
+    // copied, and the arrays of the one before it are re-used for the new matrix.
     SparseMatrix& previous = previous_;
     previous.swap(kept_.empty() ? a_ : kept_block_);
     a_ = a;
@@ -202,10 +202,12 @@ class CpuCgSolver final : public LinearSolver {
     // (b_k - A_kh x_h). Projected CG would need as many iterations as this solve constrains
     // kept DOFs (a press after a cut freed pieces: 9 iterations, 5.5 ms on the organ liver).
     const bool kept_direct = !kept_.empty() && held_mask_.cwiseProduct(free_mask).isZero(0);
+    const bool cut_matrix = matrix_is_new_;  // its first solve only
+    matrix_is_new_ = false;
     if (chol_ && (kept_.empty() || kept_direct) && settings.max_iterations > 0) {
       // A cut's matrix is not solved by the last solution: no product to find out.
-      const double warm = matrix_is_new_ ? std::numeric_limits<double>::infinity()
-                                         : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
+      const double warm = cut_matrix ? std::numeric_limits<double>::infinity()
+                                     : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
       if (warm > settings.tolerance) {
         Vector direct = x;
         if (kept_.empty()) {
@@ -221,7 +223,6 @@ class CpuCgSolver final : public LinearSolver {
           direct(kept_) = xk;
         }
         result.iterations = 1;
-        matrix_is_new_ = false;
         const double res = (b - a_ * direct).cwiseProduct(free_mask).norm() / rhs_norm;
         if (res < warm) x = std::move(direct);
         result.residual = std::min(res, warm);
@@ -384,7 +385,7 @@ class CpuCgSolver final : public LinearSolver {
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
   SparseMatrix previous_;       // the block before the last set_matrix (its arrays reused)
-  bool matrix_is_new_ = false;  // set_matrix since the last direct step
+  bool matrix_is_new_ = false;  // a cut's set_matrix, not solved with since
   // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;

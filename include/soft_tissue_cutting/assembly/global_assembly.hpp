@@ -38,6 +38,16 @@ SparseMatrix assemble_block(const TetMesh& mesh, const ElementStiffnessCache& el
                             const std::vector<int>& tets, const DofMap& map_rows,
                             const DofMap& map_cols);
 
+// a += d for a symmetric a and a difference d whose rows are non-zero only where `touched`
+// (a cut's changed element matrices, docs/DESIGN.md section 6.2), in one pass: the rows d does
+// not touch are copied bit for bit, the touched ones merged, and d may have more rows (new DOFs,
+// appended). An entry in a touched row and a touched column that sums to within
+// `drop` x sqrt(|a_rr a_cc|) of zero is dropped: couplings the change removed cancel to
+// rounding, not to zero. Written into `spare` (its arrays re-used, not fresh pages) and
+// swapped into a.
+void add_difference(SparseMatrix& a, const SparseMatrix& d,
+                    const std::vector<std::uint8_t>& touched, double drop, SparseMatrix& spare);
+
 // DOF map of every DOF of `nodes` (in that order) that is not fixed.
 DofMap make_dof_map(int num_nodes, const std::vector<int>& nodes,
                     const std::vector<std::uint8_t>& fixed_node);

@@ -1,6 +1,8 @@
 // Global assembly (docs/DESIGN.md eq. (5)): assemble_block writes compressed rows directly
 // from the elements; against the sum of the element triplets (Eigen's setFromTriplets), on
-// square and rectangular blocks, with fixed nodes and nodes in no listed tet.
+// square and rectangular blocks, with fixed nodes and nodes in no listed tet. add_difference
+// (a cut's update by difference) keeps untouched rows bit for bit, merges the touched ones,
+// appends new rows and drops what cancels.
 #include "common/meshes.hpp"
 #include "soft_tissue_cutting/assembly/element_cache.hpp"
 #include "soft_tissue_cutting/assembly/global_assembly.hpp"
@@ -70,6 +72,36 @@ TEST(GlobalAssembly, DirectCompressedRowsEqualTheSumOfElementTriplets) {
   const SparseMatrix empty = assemble_block(mesh, elements, {}, rows, cols);
   EXPECT_EQ(empty.nonZeros(), 0);
   EXPECT_EQ(empty.rows(), rows.rows());
+}
+
+TEST(GlobalAssembly, AddDifferenceKeepsUntouchedRowsAndDropsWhatCancels) {
+  // a: 4 x 4, symmetric; d touches rows 1 and 2, cancels the (1, 2) coupling, adds a new
+  // DOF 4 coupled to row 2.
+  std::vector<Triplet> ta = {{0, 0, 4},  {0, 1, -1}, {1, 0, -1}, {1, 1, 4},
+                             {1, 2, -1}, {2, 1, -1}, {2, 2, 4},  {3, 3, 2}};
+  SparseMatrix a(4, 4);
+  a.setFromTriplets(ta.begin(), ta.end());
+  // -1 + (1 - 1e-15): a coupling that cancels to rounding, not to zero.
+  std::vector<Triplet> td = {{1, 2, 1 - 1e-15}, {2, 1, 1 - 1e-15}, {1, 1, 0.5},
+                             {2, 4, -0.5},      {4, 2, -0.5},      {4, 4, 1.0}};
+  SparseMatrix d(5, 5);
+  d.setFromTriplets(td.begin(), td.end());
+  const std::vector<std::uint8_t> touched = {0, 1, 1, 0, 1};
+  SparseMatrix spare;
+  const SparseMatrix before = a;
+  add_difference(a, d, touched, 1e-12, spare);
+  ASSERT_EQ(a.rows(), 5);
+  EXPECT_EQ(a.coeff(0, 0), before.coeff(0, 0));  // untouched rows as they were
+  EXPECT_EQ(a.coeff(0, 1), before.coeff(0, 1));
+  EXPECT_EQ(a.coeff(3, 3), before.coeff(3, 3));
+  EXPECT_EQ(a.coeff(1, 1), 4.5);
+  EXPECT_EQ(a.coeff(2, 4), -0.5);
+  EXPECT_EQ(a.coeff(4, 2), -0.5);
+  EXPECT_EQ(a.coeff(4, 4), 1.0);
+  EXPECT_EQ(a.nonZeros(), 8 - 2 + 3);  // (1, 2), (2, 1) dropped; (2, 4), (4, 2), (4, 4) added
+  for (int r = 0; r < a.rows(); ++r)
+    for (SparseMatrix::InnerIterator it(a, r); it; ++it)
+      EXPECT_NE(it.value(), 0.0) << r << ", " << it.index();
 }
 
 }  // namespace
