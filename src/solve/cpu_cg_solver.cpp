@@ -63,10 +63,14 @@ constexpr double kShift = 1e-9;
 // The frame a factorization after a cut keeps for the next cuts (framed_cholesky.hpp): the
 // rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
 // the same tets or their neighbours: 22 of the organ stroke's 31 cuts fall inside; two rings
-// took hardly more and doubled the frame's cost), and at most kMaxFrame DOFs: the frame's
-// dense Schur complement costs |B|^3/3 per cut (a change of E changes every row: no frame).
+// took hardly more and doubled the frame's cost). Its dense Schur complement costs |B|^3/3 per
+// cut and 3 |B|^2 doubles (L_BB, W, the factor of S'): a frame grown past kMaxFrame DOFs, or
+// past half the block, refactors instead (900 DOFs: 20 MB and ~10 ms, more than the thigh's
+// whole refactorization; a soak-like random walk on the thigh reached it). A change of E
+// changes every row: no frame.
 constexpr int kFrameRings = 1;
-constexpr int kMaxFrame = 900;
+constexpr int kMaxFrame = 600;
+int max_frame(Eigen::Index rows) { return std::min<int>(kMaxFrame, static_cast<int>(rows / 2)); }
 
 std::string format_residual(double r) {
   char buf[32];
@@ -338,7 +342,7 @@ class CpuCgSolver final : public LinearSolver {
       changed_since_factor_.reset();
     if (same_rows && active_ == "cholesky" &&
         chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr)) {
-      if (chol_->frame_size() <= kMaxFrame) {
+      if (chol_->frame_size() <= max_frame(block.rows())) {
         ++frame_updates_;
         return;
       }
@@ -351,7 +355,7 @@ class CpuCgSolver final : public LinearSolver {
                                  kept_.begin());
       frame = changed ? FramedCholesky::frame_around(block, *changed, dense, kFrameRings)
                       : FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
-      if (static_cast<int>(frame.size()) > kMaxFrame) frame.clear();
+      if (static_cast<int>(frame.size()) > max_frame(block.rows())) frame.clear();
     }
     chol_.reset();
     active_ = "jacobi";
