@@ -31,7 +31,6 @@ void TetFaceAdjacency::build(const TetMesh& mesh, const std::vector<int>& tets) 
   seen_.assign(mesh.tets.size(), Tet{-1, -1, -1, -1});
   member_.assign(mesh.tets.size(), 0);
   users_.assign(4 * mesh.tets.size(), 0);
-  members_ = 0;
   non_manifold_ = 0;
   update(mesh, tets);
 }
@@ -91,12 +90,8 @@ void TetFaceAdjacency::update(const TetMesh& mesh, const std::vector<int>& chang
   touched.reserve(8 * changed.size());
   for (int t : changed) {
     const size_t i = static_cast<size_t>(t);
-    if (member_[i]) {
-      remove(t, seen_[i], touched);
-    } else {
-      member_[i] = 1;
-      ++members_;
-    }
+    if (member_[i]) remove(t, seen_[i], touched);
+    member_[i] = 1;
     seen_[i] = mesh.tets[i];
     add(t, seen_[i], touched);
   }

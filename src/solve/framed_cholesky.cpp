@@ -198,8 +198,6 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
 
 FramedCholesky::~FramedCholesky() = default;
 
-int FramedCholesky::factored_rows() const { return static_cast<int>(impl_->factored.rows()); }
-
 bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* changed) {
   Impl& m = *impl_;
   const int n_old = static_cast<int>(m.factored.rows());

@@ -28,7 +28,6 @@ class TetFaceAdjacency {
   // The members' face-connected pieces: as face_connected_pieces of the members alone (tet
   // indices of `mesh`), in order of their smallest tet.
   std::vector<MeshPiece> pieces(const TetMesh& mesh) const;
-  int members() const { return members_; }
 
  private:
   using Key = std::array<int, 3>;  // sorted node triple
@@ -50,7 +49,6 @@ class TetFaceAdjacency {
   std::vector<Tet> seen_;             // each member's nodes as its faces were entered
   std::vector<std::uint8_t> member_;  // per mesh tet
   std::vector<std::uint8_t> users_;   // per 4 * tet + face: how many member tets use that face
-  int members_ = 0;
   int non_manifold_ = 0;
 };
 

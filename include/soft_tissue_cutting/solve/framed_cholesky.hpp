@@ -47,8 +47,6 @@ class FramedCholesky final : public CholeskySolve {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const override;
   int rows() const override { return rows_; }
   int frame_size() const { return static_cast<int>(frame_.size()); }
-  // Rows of the factored matrix (the F rows' reference) and of the last taken one.
-  int factored_rows() const;
   int updates() const { return updates_; }
 
   // The rows where `a` differs from `previous` (same leading rows; rows beyond previous.rows()
