@@ -25,7 +25,8 @@ echo "== GL unit tests"
 # Leading '*': parameterized suites are named Instantiation/Suite.Test/N.
 gl_tests='*GpuCg*:*GpuSpmv*:*GpuReduction*:*GpuFallback*:*GlRefinement*:*GlScenes*'
 gl_tests+=':SimulationPipeline.GlBackend*:SolveCli.GlBackend*'
-timeout 240 "$build/tissue_core_unit" --gtest_filter="$gl_tests" \
+# The offline-solver tests run BUILD_DIR's tissue_solve, not the build tree's (absent there).
+TISSUE_SOLVE_BIN="$build/tissue_solve" timeout 240 "$build/tissue_core_unit" --gtest_filter="$gl_tests" \
   --gtest_output="xml:$out/gl_tests.xml" 2>&1 | tee "$out/gl_tests.log" | grep -E '^\[ +(OK|FAILED|PASSED) |renderer|fell back'
 tests_status=${PIPESTATUS[0]}
 

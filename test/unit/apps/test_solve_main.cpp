@@ -35,10 +35,16 @@ struct SolveRun {
   std::string err;
 };
 
+// The executable CMake built, unless TISSUE_SOLVE_BIN names a copy (scripts/gpu_check.sh runs
+// the binaries from another folder on a lent GPU machine, where the build tree is absent).
+std::string solve_executable() {
+  const char* env = std::getenv("TISSUE_SOLVE_BIN");
+  return env != nullptr && *env != '\0' ? std::string(env) : std::string(TISSUE_SOLVE_BIN);
+}
+
 SolveRun run_solve(const std::string& args) {
   const fs::path err = scratch("tissue_solve_stderr.txt");
-  const std::string cmd =
-      std::string(TISSUE_SOLVE_BIN) + " " + args + " 2>" + err.string() + " >/dev/null";
+  const std::string cmd = solve_executable() + " " + args + " 2>" + err.string() + " >/dev/null";
   const int status = std::system(cmd.c_str());
   std::ifstream in(err);
   std::stringstream ss;
