@@ -31,6 +31,8 @@ void TetFaceAdjacency::build(const TetMesh& mesh, const std::vector<int>& tets) 
   seen_.assign(mesh.tets.size(), Tet{-1, -1, -1, -1});
   member_.assign(mesh.tets.size(), 0);
   users_.assign(4 * mesh.tets.size(), 0);
+  other_.assign(4 * mesh.tets.size(), -1);
+  crowded_.clear();
   non_manifold_ = 0;
   update(mesh, tets);
 }
@@ -74,8 +76,18 @@ void TetFaceAdjacency::refresh(const Key& key) {
     face.non_manifold = same;
   }
   non_manifold_ += face.non_manifold;
-  for (int u : face.users)
+  for (int u : face.users) {
     users_[static_cast<size_t>(u)] = static_cast<std::uint8_t>(std::min<size_t>(n, 255));
+    other_[static_cast<size_t>(u)] = -1;
+  }
+  if (n == 2) {
+    other_[static_cast<size_t>(face.users[0])] = face.users[1];
+    other_[static_cast<size_t>(face.users[1])] = face.users[0];
+  }
+  const auto crowded = std::lower_bound(crowded_.begin(), crowded_.end(), key);
+  const bool listed = crowded != crowded_.end() && *crowded == key;
+  if (n > 2 && !listed) crowded_.insert(crowded, key);
+  if (n <= 2 && listed) crowded_.erase(crowded);
   if (n == 0) faces_.erase(it);
 }
 
@@ -85,6 +97,7 @@ void TetFaceAdjacency::update(const TetMesh& mesh, const std::vector<int>& chang
     seen_.resize(tets, Tet{-1, -1, -1, -1});
     member_.resize(tets, 0);
     users_.resize(4 * tets, 0);
+    other_.resize(4 * tets, -1);
   }
   std::vector<Key> touched;
   touched.reserve(8 * changed.size());
@@ -118,11 +131,16 @@ std::vector<MeshPiece> TetFaceAdjacency::pieces(const TetMesh& mesh) const {
   // face_connected_pieces does).
   std::vector<int> parent(member_.size());
   std::iota(parent.begin(), parent.end(), 0);
-  for (const auto& [key, face] : faces_)
-    for (size_t k = 1; k < face.users.size(); ++k) {
-      const int a = find_root(parent, face.users[0] / 4), b = find_root(parent, face.users[k] / 4);
-      if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-    }
+  auto join = [&parent](int x, int y) {
+    const int a = find_root(parent, x), b = find_root(parent, y);
+    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  };
+  for (size_t slot = 0; slot < other_.size(); ++slot)
+    if (other_[slot] >= 0 && member_[slot / 4]) join(static_cast<int>(slot / 4), other_[slot] / 4);
+  for (const Key& key : crowded_) {
+    const std::vector<int>& users = faces_.at(key).users;
+    for (size_t k = 1; k < users.size(); ++k) join(users[0] / 4, users[k] / 4);
+  }
   std::vector<int> piece_of_root(member_.size(), -1);
   std::vector<MeshPiece> pieces;
   for (size_t t = 0; t < member_.size(); ++t) {

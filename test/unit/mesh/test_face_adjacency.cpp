@@ -157,5 +157,27 @@ TEST(TetFaceAdjacency, FollowsSweepsThatSeverPieces) {
   }
 }
 
+// A face of more than two tets (a non-manifold input) joins all of them into one piece, as
+// face_connected_pieces does, and stops doing so once a tet is rewritten off it.
+TEST(TetFaceAdjacency, FaceOfThreeTetsJoinsThemUntilOneLeaves) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0),     Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(0, 0, -1),
+                Vec3(0.2, 0.2, 1), Vec3(3, 3, 3), Vec3(4, 3, 3), Vec3(3, 4, 3)};
+  mesh.tets = {{0, 1, 2, 3}, {0, 2, 1, 4}, {0, 1, 2, 5}};
+  std::vector<int> members = {0, 1, 2};
+  TetFaceAdjacency adjacency;
+  adjacency.build(mesh, members);
+  expect_same(adjacency, mesh, members, "three tets on one face");
+  ASSERT_EQ(adjacency.pieces(mesh).size(), 1u);
+  mesh.tets[2] = {6, 7, 8, 5};  // off the shared face: two tets share it now
+  adjacency.update(mesh, {2});
+  expect_same(adjacency, mesh, members, "one tet rewritten off it");
+  EXPECT_EQ(adjacency.pieces(mesh).size(), 2u);
+  mesh.tets[2] = {0, 1, 2, 5};  // and back
+  adjacency.update(mesh, {2});
+  expect_same(adjacency, mesh, members, "and back");
+  EXPECT_EQ(adjacency.pieces(mesh).size(), 1u);
+}
+
 }  // namespace
 }  // namespace stc
