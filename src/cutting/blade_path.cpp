@@ -51,4 +51,30 @@ std::vector<BladePose> resample_blade_path(const std::vector<BladePose>& poses, 
   return out;
 }
 
+size_t straight_sweep_steps(const std::vector<BladePose>& poses, double blade_length,
+                            double tolerance, double max_travel) {
+  if (poses.size() < 2) return 0;
+  const Vec3 edge = Vec3::UnitX() * blade_length;
+  std::vector<Vec3> tip, heel;
+  std::vector<double> travel = {0.0};  // from poses[0]
+  for (const BladePose& p : poses) {
+    tip.push_back(p.position);
+    heel.push_back(p.position + p.orientation.normalized() * edge);
+  }
+  for (size_t i = 1; i < poses.size(); ++i)
+    travel.push_back(travel.back() + blade_travel(poses[i - 1], poses[i], blade_length));
+  size_t best = 1;
+  for (size_t k = 2; k < poses.size() && travel[k] <= max_travel; ++k) {
+    bool straight = travel[k] > 0;
+    for (size_t j = 1; j < k && straight; ++j) {
+      const double s = travel[j] / travel[k];
+      straight = (tip[j] - (tip[0] + s * (tip[k] - tip[0]))).norm() <= tolerance &&
+                 (heel[j] - (heel[0] + s * (heel[k] - heel[0]))).norm() <= tolerance;
+    }
+    if (!straight) break;
+    best = k;
+  }
+  return best;
+}
+
 }  // namespace stc

@@ -10,6 +10,7 @@
 #include "soft_tissue_cutting/cutting/blade_path.hpp"
 #include "soft_tissue_cutting/cutting/rest_mapping.hpp"
 #include "soft_tissue_cutting/gpu/gl_solver.hpp"
+#include "soft_tissue_cutting/mesh/face_adjacency.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <deque>
+#include <numeric>
 #include <stdexcept>
 
 namespace stc {
@@ -71,7 +73,11 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
-  OperationSurface boundary;           // the boundary after cuts from part 1 alone
+  OperationSurface boundary;  // the boundary after cuts from part 1 alone
+  // `follow`: which tets of the whole mesh share each face, kept across cuts and moves (a move
+  // changes the partition, not the mesh), so the free-piece search after a cut matches only
+  // the faces the cut changed (docs/DESIGN.md section 10a, "Free pieces").
+  TetFaceAdjacency mesh_faces;
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -168,6 +174,11 @@ struct Simulation::Impl {
     // The initial equilibrium under the scene's loads.
     last.converged = solve({}, last);
     boundary.init(model->mesh(), model->partition().operation_tet);
+    if (follower) {
+      std::vector<int> all(model->mesh().tets.size());
+      std::iota(all.begin(), all.end(), 0);
+      mesh_faces.build(model->mesh(), all);
+    }
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;
     ++mesh_version;
@@ -292,6 +303,7 @@ struct Simulation::Impl {
     ++mesh_version;
     model->update_operation_part(r.changed_tets, r.new_nodes);
     boundary.update(model->mesh(), r.changed_tets);
+    if (follower) mesh_faces.update(model->mesh(), r.changed_tets);
     // A copy of a held node stays held (both halves of a cut held piece stay put).
     for (const NewNode& n : r.new_nodes)
       if (n.kind == NewNode::Kind::kDuplicate)
@@ -344,9 +356,9 @@ struct Simulation::Impl {
   // it is.
   void hold_free_pieces() {
     // A fixed region: part 1's pieces, from the faces the cuts kept matched (operation_surface).
-    const std::vector<MeshPiece> pieces =
-        follower ? free_pieces(model->mesh(), anchored)
-                 : free_pieces(boundary.part1_pieces(model->mesh()), model->mesh(), anchored);
+    const std::vector<MeshPiece> pieces = free_pieces(
+        follower ? mesh_faces.pieces(model->mesh()) : boundary.part1_pieces(model->mesh()),
+        model->mesh(), anchored);
     for (const MeshPiece& piece : pieces) hold_piece(piece);
     log_pieces_held(pieces);
   }
@@ -523,7 +535,8 @@ struct Simulation::Impl {
       }
       Sweep& sw = pending_sweeps.front();
       const BladeEdge a = blade_edge(sw.from, length), b = blade_edge(sw.to, length);
-      if (sw.moves_tried < 2 && !follower->sweep_fits(*model, cut_state, a, b)) {
+      const bool fits = follower->sweep_fits(*model, cut_state, a, b);
+      if (sw.moves_tried < 2 && !fits) {
         const Vec3 centre = follower->centre_for(*model, cut_state, follower->sweep_points(a, b),
                                                  sw.to.position - sw.from.position);
         if (follower->worth_moving_to(centre)) {
@@ -537,9 +550,36 @@ struct Simulation::Impl {
           return;
         }
       }
-      cut(sw.from, sw.to, s);
-      pending_sweeps.pop_front();
+      const size_t steps = fits ? straight_waiting_steps() : 1;
+      cut(sw.from, pending_sweeps[steps - 1].to, s);
+      pending_sweeps.erase(pending_sweeps.begin(),
+                           pending_sweeps.begin() + static_cast<long>(steps));
     }
+  }
+
+  // How many waiting sweeps, from the first (which the region holds), one cut takes: those that
+  // follow on from each other, that the region holds, and that the blade drew straight (within
+  // the 0.25 mm to which the cut's rest polylines are simplified anyway) over at most one
+  // median edge. After a move the queue holds every sweep since the request (hundreds at
+  // organ scale, 0.2 mm apart), and each cut costs a model update: one cut per straight
+  // stretch keeps the swap step short (docs/DESIGN.md section 10a, "Swap").
+  size_t straight_waiting_steps() {
+    const double length = scene.scalpel.blade_length;
+    std::vector<BladePose> run = {pending_sweeps.front().from, pending_sweeps.front().to};
+    double travel = blade_travel(run[0], run[1], length);
+    for (size_t k = 1; k < pending_sweeps.size() && travel <= cut_spacing; ++k) {
+      const Sweep& next = pending_sweeps[k];
+      const BladePose& end = run.back();
+      if (next.from.position != end.position ||
+          next.from.orientation.coeffs() != end.orientation.coeffs())
+        break;  // another stroke
+      if (!follower->sweep_fits(*model, cut_state, blade_edge(next.from, length),
+                                blade_edge(next.to, length)))
+        break;
+      travel += blade_travel(next.from, next.to, length);
+      run.push_back(next.to);
+    }
+    return std::max<size_t>(1, straight_sweep_steps(run, length, 0.25e-3, cut_spacing));
   }
 
   // A blade near tissue the region does not hold clear of its interface: a move around it.

@@ -25,4 +25,13 @@ double blade_path_length(const std::vector<BladePose>& poses, double blade_lengt
 std::vector<BladePose> resample_blade_path(const std::vector<BladePose>& poses, double blade_length,
                                            double spacing);
 
+// How many steps of `poses` (a blade's consecutive poses) one straight sweep from poses[0] to
+// poses[k] can stand for: the largest k whose travel is at most `max_travel` and at whose
+// every pose in between the tip and the heel lie within `tolerance` of where that straight
+// sweep has them (interpolated by travel). At least 1 when there are two poses or more, 0
+// otherwise. Waiting sweeps of a `follow` region are cut this way after a move
+// (docs/DESIGN.md section 10a, "Swap").
+size_t straight_sweep_steps(const std::vector<BladePose>& poses, double blade_length,
+                            double tolerance, double max_travel);
+
 }  // namespace stc

@@ -58,6 +58,40 @@ TEST(BladePath, DegeneratePathsComeBackAsTheyAre) {
   EXPECT_EQ(resample_blade_path({a, a}, 0.02, 0.001).size(), 2u);
 }
 
+// A `follow` region's waiting sweeps are cut as one straight sweep where the blade went
+// straight (simulation.cpp, straight_waiting_steps): how far one sweep may stand for the steps.
+TEST(BladePath, StraightSweepStepsStopAtACornerATurnOrTheTravelLimit) {
+  const double blade = 0.02, tolerance = 0.05e-3;
+  // A straight line 0.2 mm per step: every step, or as many as the travel limit allows.
+  const auto straight = line(Vec3(0, 0, 0), Vec3(2e-3, 0, 0), 11);
+  EXPECT_EQ(straight_sweep_steps(straight, blade, tolerance, 1.0), 10u);
+  EXPECT_EQ(straight_sweep_steps(straight, blade, tolerance, 1.1e-3), 5u);
+  // A corner after 5 steps: the sixth pose is 0.2 mm off the line, the 5th off the chord.
+  std::vector<BladePose> corner = line(Vec3(0, 0, 0), Vec3(1e-3, 0, 0), 6);
+  for (const BladePose& p : line(Vec3(1e-3, 0, 0), Vec3(1e-3, 1e-3, 0), 6))
+    if (p.position != corner.back().position) corner.push_back(p);
+  EXPECT_EQ(straight_sweep_steps(corner, blade, tolerance, 1.0), 5u);
+  // The tip stands still and the blade turns about it: the heel sweeps an arc (0.87 mm off
+  // its chord over 10 degrees), so only the steps whose arc stays within the tolerance.
+  std::vector<BladePose> turn;
+  for (int i = 0; i <= 10; ++i) {
+    BladePose p;
+    p.orientation = Eigen::AngleAxisd(i * M_PI / 180, Vec3::UnitZ());
+    turn.push_back(p);
+  }
+  const size_t k = straight_sweep_steps(turn, blade, tolerance, 1.0);
+  EXPECT_GE(k, 1u);
+  EXPECT_LT(k, 10u);
+  // sagitta of the heel's arc over k degrees within the tolerance, over k + 1 not
+  auto sagitta = [&](int deg) { return blade * (1 - std::cos(0.5 * deg * M_PI / 180)); };
+  EXPECT_LE(sagitta(static_cast<int>(k)), tolerance * 1.01);
+  EXPECT_GT(sagitta(static_cast<int>(k) + 1), tolerance * 0.5);
+  // Too few poses.
+  EXPECT_EQ(straight_sweep_steps({}, blade, tolerance, 1.0), 0u);
+  EXPECT_EQ(straight_sweep_steps({straight[0]}, blade, tolerance, 1.0), 0u);
+  EXPECT_EQ(straight_sweep_steps({straight[0], straight[1]}, blade, tolerance, 0.0), 1u);
+}
+
 // The same straight stroke sent as 10 .. 10,000 poses opens the same cut faces.
 void expect_density_independent(const Scene& scene, const Vec3& a, const Vec3& b,
                                 const Eigen::Quaterniond& q) {
