@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <deque>
+#include <future>
 #include <numeric>
 #include <stdexcept>
 
@@ -78,6 +79,8 @@ struct Simulation::Impl {
   // changes the partition, not the mesh), so the free-piece search after a cut matches only
   // the faces the cut changed (docs/DESIGN.md section 10a, "Free pieces").
   TetFaceAdjacency mesh_faces;
+  std::future<void> retiring;  // `follow`: the model a swap replaced, being freed (retire)
+  std::future<DisplacementSnapshot> recovering;  // `follow`, online: the old model's S and Q
   std::vector<std::uint8_t> anchored;  // fixed or interface (or held): pieces with one stay put
   ImposedDisplacements held;           // free pieces, held where they came free
   int free_pieces_held = 0;
@@ -129,6 +132,8 @@ struct Simulation::Impl {
 
   void start() {
     follower.reset();  // waits for a running move: it reads the model replaced below
+    if (recovering.valid()) recovering.wait();  // it reads the old condensed part only
+    recovering = {};
     pending_sweeps.clear();
     held_piece_nodes.clear();
     scene = initial;
@@ -465,10 +470,11 @@ struct Simulation::Impl {
   // for it). The swap changes no displacement (region_follower.hpp).
   void adopt_moved_region(StepStats& s, bool wait) {
     if (!follower || !follower->moving()) return;
-    if (!wait && !follower->ready()) {
+    if (!wait && !(follower->ready() && recovering.valid())) {
       s.region_moving = true;
       return;
     }
+    const Vector state = state_for_moved_region();
     std::string failure;
     std::optional<MovedRegion> moved = follower->take(&failure);
     if (!moved) {
@@ -482,10 +488,12 @@ struct Simulation::Impl {
         follower->dropped();
         return;
       }
-    next.set_displacement(model->displacement());  // S and Q recovered: the whole state
+    next.set_displacement(state);
     next.set_cg_settings(model->cg_settings());
     if (backend == "gl") next.set_solver(make_solver());
+    std::unique_ptr<HybridModel> replaced = std::move(model);
     model = std::move(moved->model);
+    retire(std::move(replaced));
     apply_partition_to_cut_state(*moved, cut_state);
     boundary = std::move(moved->boundary);
     follower->adopted(*moved);
@@ -522,13 +530,60 @@ struct Simulation::Impl {
     s.region_moved = true;
   }
 
+  // Online, the old model's S and Q for a swap are recovered on another thread (one solve with
+  // its K2_NN factor: ~20 ms at organ scale), from a snapshot of the state a step ends in,
+  // started then once the move's worker has finished; the swap, at the next step's start, takes
+  // them (state_for_moved_region).
+  void recover_for_swap() {
+    if (!follower || options.wait_for_region_moves || recovering.valid() || !follower->ready())
+      return;
+    recovering = std::async(std::launch::async, [snapshot = model->displacement_snapshot()]() {
+      DisplacementSnapshot recovered = snapshot;
+      recovered.recover();
+      return recovered;
+    });
+  }
+
+  // The whole state, every node current, that the moved region's model starts from: S and Q
+  // from the recovery started at the end of the last step when u_I is still what it was then
+  // (nothing solves between two steps; they depend on u_I alone), else recovered now.
+  Vector state_for_moved_region() {
+    if (!recovering.valid()) return model->displacement();
+    const DisplacementSnapshot recovered = recovering.get();  // waits for the rest of it
+    const Vector& now = model->operation_displacement();
+    bool same = recovered.u.size() == now.size();
+    for (int n : model->partition().interface)
+      same = same && recovered.u.segment<3>(3 * n) == now.segment<3>(3 * n);
+    if (!same) return model->displacement();
+    Vector u = now;
+    for (const std::vector<int>* nodes :
+         {&model->partition().surface, &model->partition().interior})
+      for (int n : *nodes) u.segment<3>(3 * n) = recovered.u.segment<3>(3 * n);
+    return u;
+  }
+
+  // The model a swap replaced is freed on another thread: its factors and dense blocks are
+  // hundreds of MB at organ scale, ~6 ms of the swap step to give back. Not with the gl
+  // backend: its GL objects belong to this thread's context.
+  void retire(std::unique_ptr<HybridModel> replaced) {
+    if (backend == "gl") return;  // freed here
+    if (retiring.valid()) retiring.wait();
+    retiring = std::async(std::launch::async, [m = std::move(replaced)]() mutable { m.reset(); });
+  }
+
   // Cuts the waiting sweeps in order while each fits the region; a sweep that would come
   // within one element layer of the interface asks for a move around it and waits (the cut
   // waits at the interface). A sweep no ball of radius R around it can hold is cut as far as
-  // the region reaches, like a fixed region's.
+  // the region reaches, like a fixed region's. Online, cutting stops for this step once it has
+  // taken SimulationOptions::waiting_cut_budget_ms (at least one sweep is cut).
   void drain_sweeps(StepStats& s, bool wait) {
+    if (!wait && s.region_moved) return;  // online: from the step after the swap (above)
     const double length = scene.scalpel.blade_length;
+    const auto t0 = Clock::now();
+    int runs_cut = 0;
     while (!pending_sweeps.empty()) {
+      if (!wait && runs_cut > 0 && ms_since(t0) > options.waiting_cut_budget_ms)
+        return;  // the rest from the next step on
       if (follower->moving()) {
         s.reached_interface = true;  // the cut waits at the interface for the move
         return;
@@ -552,6 +607,7 @@ struct Simulation::Impl {
       }
       const size_t steps = fits ? straight_waiting_steps() : 1;
       cut(sw.from, pending_sweeps[steps - 1].to, s);
+      ++runs_cut;
       pending_sweeps.erase(pending_sweeps.begin(),
                            pending_sweeps.begin() + static_cast<long>(steps));
     }
@@ -733,6 +789,7 @@ struct Simulation::Impl {
     blade_imposed = std::move(imposed);  // not read below
     if (s.cg_iterations > 0 || s.cutting || s.region_moved)
       ++surface_version;  // the drawn surface changed
+    recover_for_swap();
     s.step_ms = ms_since(t_step);
     last = s;
     return s;
