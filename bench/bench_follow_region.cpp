@@ -2,13 +2,15 @@
 // move takes (re-partition + re-condensation of part 2 + hybrid assembly and factorization, as
 // the worker thread runs it) at paper scale (the built-in thigh) and on the organ-scale liver
 // of config/scenes/liver_organ.yaml (its 2 cm sphere made a `follow` ball); the same model built
-// from scratch (element matrices recomputed) for the gain of re-using them; and the per-step solve
-// while a move runs on the other core.
+// from scratch (element matrices recomputed) for the gain of re-using them; the per-step solve
+// while a move runs on the other core; and a whole stroke played online at 100 Hz.
 #include "simulation/region_follower.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
+#include "soft_tissue_cutting/simulation/region_move_stats.hpp"
+#include "soft_tissue_cutting/simulation/simulation.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -19,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <thread>
 
 namespace stc {
 namespace {
@@ -163,6 +166,79 @@ BENCHMARK(BM_StepDuringMove)
     ->Args({1, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
+
+// A stroke played online as the node plays it: one step every 10 ms (100 Hz), moves on the
+// worker, no step waiting for one (docs/DESIGN.md section 10a, "Swap"). Paper scale:
+// config/scenes/thigh_follow.yaml (7k tets, 2.5 cm ball), pressed in and drawn 10 cm at
+// 0.5 mm per step; organ scale: the liver above (2 cm ball), pressed 1 cm in and drawn 4 cm
+// at 0.05 mm per step (5 mm/s). Counters: every step's wall time (median, p90, max), the
+// steps that swapped a moved region in and those that cut (median, max), moves, tets added.
+void BM_OnlineFollowStroke(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  Scene scene;
+  std::vector<BladePose> poses;
+  auto line = [&poses](const Vec3& a, const Vec3& b, int steps, const Eigen::Quaterniond& q) {
+    for (int k = 1; k <= steps; ++k) {
+      BladePose p;
+      p.position = a + (b - a) * (static_cast<double>(k) / steps);
+      p.orientation = q;
+      poses.push_back(p);
+    }
+  };
+  if (which == 0) {
+    scene = load_scene(TISSUE_SHARED_MESH_DIR "/../scenes/thigh_follow.yaml");
+    const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // edge radially out (+x)
+    const double x_in = 0.06 - 0.012;
+    line(Vec3(0.065, 0.003, 0.02), Vec3(0.065, 0.003, 0.02), 1, q);
+    line(Vec3(0.065, 0.003, 0.02), Vec3(x_in, 0.003, 0.02), 17, q);
+    line(Vec3(x_in, 0.003, 0.02), Vec3(x_in, 0.003, 0.12), 200, q);
+    line(Vec3(x_in, 0.003, 0.12), Vec3(0.07, 0.003, 0.12), 20, q);
+  } else {
+    scene = liver_case().scene;
+    const Eigen::Quaterniond q(0.5, 0.5, 0.5, 0.5);  // edge up (+y), blade normal +z
+    const Vec3 above(-0.092, 0.012, 1.2069), in(-0.092, -0.010, 1.2069);
+    line(above, above, 1, q);
+    line(above, in, 30, q);
+    line(in, in + Vec3(0.04, 0, 0), 800, q);
+    line(in + Vec3(0.04, 0, 0), in + Vec3(0.04, 0.022, 0), 20, q);
+  }
+  std::vector<double> steps, swaps, cuts;
+  int moves = 0, tets_added = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    Simulation sim(scene);
+    const int tets = sim.counts().tets;
+    state.ResumeTiming();
+    auto next = std::chrono::steady_clock::now();
+    for (const BladePose& pose : poses) {
+      next += std::chrono::milliseconds(10);
+      const StepStats s = sim.step(pose);
+      steps.push_back(s.step_ms);
+      if (s.region_moved) swaps.push_back(s.step_ms);
+      if (s.cutting) cuts.push_back(s.step_ms);
+      std::this_thread::sleep_until(next);
+    }
+    moves = sim.region_moves()->moves;
+    tets_added = sim.counts().tets - tets;
+  }
+  auto at = [](std::vector<double> v, double f) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, static_cast<size_t>(f * static_cast<double>(v.size())))];
+  };
+  state.counters["step_median_ms"] = at(steps, 0.5);
+  state.counters["step_p90_ms"] = at(steps, 0.9);
+  state.counters["step_max_ms"] = at(steps, 1.0);
+  state.counters["swap_median_ms"] = at(swaps, 0.5);
+  state.counters["swap_max_ms"] = at(swaps, 1.0);
+  state.counters["cutting_median_ms"] = at(cuts, 0.5);
+  state.counters["cutting_max_ms"] = at(cuts, 1.0);
+  state.counters["moves"] = moves;
+  state.counters["tets_added"] = tets_added;
+  state.SetLabel(which == 0 ? "thigh_follow (paper scale), 0.5 mm per 10 ms step"
+                            : "liver (organ scale), 0.05 mm per 10 ms step");
+}
+BENCHMARK(BM_OnlineFollowStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 }  // namespace stc
