@@ -95,7 +95,8 @@ HybridModel::HybridModel(const Scene& scene, std::unique_ptr<LinearSolver> solve
 }
 
 HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
-                         const std::vector<int>& held_nodes, std::unique_ptr<LinearSolver> solver)
+                         const std::vector<int>& held_nodes, std::unique_ptr<LinearSolver> solver,
+                         const std::vector<int>& expected_cut_nodes)
     : mesh_(from.mesh_),
       gravity_(from.gravity_),
       point_loads_(from.point_loads_),
@@ -112,6 +113,7 @@ HybridModel::HybridModel(const HybridModel& from, std::vector<std::uint8_t> oper
   partition_ = partition_from_labels(mesh_, std::move(operation_tet));
   timings_["partition"] = ms_since(t0);
   timings_["element_stiffness"] = 0;  // re-used from `from`
+  expected_cut_nodes_ = expected_cut_nodes;
   condense_and_assemble(start);
 }
 
@@ -200,6 +202,14 @@ void HybridModel::refresh_factor() const {
   history.kept_rows = static_cast<int>(common.first - solver_dofs_.begin());
   history.interface_rows = static_cast<int>(interface_row_.size());  // the leading rows
   if (rows_changed_) history.changed_rows = &*rows_changed_;
+  std::vector<int> expected_rows;
+  for (int node : expected_cut_nodes_)
+    for (int c = 0; c < 3; ++c)
+      if (node >= 0 && 3 * node + c < static_cast<int>(dofs_.row_of.size()))
+        if (const int r = dofs_.row_of[static_cast<size_t>(3 * node + c)]; r >= 0)
+          expected_rows.push_back(r);
+  expected_cut_nodes_.clear();
+  if (!expected_rows.empty()) history.expected_rows = &expected_rows;
   solver_->set_matrix(a_, held_dofs(), history);
   solver_dofs_ = now;
   rows_changed_.emplace();  // from here on, every change is listed (update_hybrid_matrix)

@@ -143,49 +143,62 @@ bool RegionFollower::worth_moving_to(const Vec3& centre) const {
 }
 
 void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
-                           std::vector<int> held_nodes, std::string reason) {
+                           std::vector<int> held_nodes, std::string reason,
+                           std::vector<Vec3> cut_points) {
   if (moving()) return;
   requested_at_ = Clock::now();
   stats_.moving = true;
   stats_.last_reason = std::move(reason);
   const Sphere ball{centre, stats_.ball.radius};
   // The second core: the old model keeps solving on the caller's thread meanwhile.
-  work_ = std::async(std::launch::async, [&from, ball, keep = std::move(keep_nodes),
-                                          held = std::move(held_nodes)]() mutable {
-    const auto t0 = Clock::now();
-    MovedRegion r;
-    r.centre = ball.center;
-    // The free pieces: anchored by fixed or held nodes only (any interface is the old
-    // partition's). Every node of one stays in part 1 (keep) and is held before the new
-    // model's first factorization (its rigid modes would make the hybrid matrix singular).
-    std::vector<std::uint8_t> anchored = from.fixed_nodes();
-    anchored.resize(from.mesh().nodes.size(), 0);
-    for (int n : held) anchored[static_cast<size_t>(n)] = 1;
-    for (const MeshPiece& piece : free_pieces(from.mesh(), anchored)) {
-      held.insert(held.end(), piece.nodes.begin(), piece.nodes.end());
-      r.found_pieces.push_back(static_cast<int>(piece.tets.size()));
-    }
-    std::sort(held.begin(), held.end());
-    held.erase(std::unique(held.begin(), held.end()), held.end());
-    keep.insert(keep.end(), held.begin(), held.end());
-    r.model =
-        std::make_unique<HybridModel>(from, follow_region_labels(from.mesh(), ball, keep), held);
-    r.held_nodes = std::move(held);
-    const TetMesh& mesh = r.model->mesh();
-    const Partition& p = r.model->partition();
-    r.boundary.init(mesh, p.operation_tet);
-    r.cuttable = p.operation_tet;
-    r.locked.assign(mesh.nodes.size(), 0);
-    std::vector<std::uint8_t> condensed(p.operation_tet.size(), 0);
-    for (int t : p.condensed_tets) {
-      condensed[static_cast<size_t>(t)] = 1;
-      for (int v : mesh.tets[static_cast<size_t>(t)]) r.locked[static_cast<size_t>(v)] = 1;
-    }
-    r.cut_grid = grid_of(mesh, r.cuttable);
-    r.condensed_grid = grid_of(mesh, condensed);
-    r.ms = ms_since(t0);
-    return r;
-  });
+  work_ = std::async(
+      std::launch::async, [&from, ball, keep = std::move(keep_nodes), held = std::move(held_nodes),
+                           points = std::move(cut_points), reach = spacing_]() mutable {
+        const auto t0 = Clock::now();
+        MovedRegion r;
+        r.centre = ball.center;
+        // The free pieces: anchored by fixed or held nodes only (any interface is the old
+        // partition's). Every node of one stays in part 1 (keep) and is held before the new
+        // model's first factorization (its rigid modes would make the hybrid matrix singular).
+        std::vector<std::uint8_t> anchored = from.fixed_nodes();
+        anchored.resize(from.mesh().nodes.size(), 0);
+        for (int n : held) anchored[static_cast<size_t>(n)] = 1;
+        for (const MeshPiece& piece : free_pieces(from.mesh(), anchored)) {
+          held.insert(held.end(), piece.nodes.begin(), piece.nodes.end());
+          r.found_pieces.push_back(static_cast<int>(piece.tets.size()));
+        }
+        std::sort(held.begin(), held.end());
+        held.erase(std::unique(held.begin(), held.end()), held.end());
+        keep.insert(keep.end(), held.begin(), held.end());
+        std::vector<std::uint8_t> labels = follow_region_labels(from.mesh(), ball, keep);
+        // The nodes of the new part-1 tets near where the next cut is expected.
+        std::vector<int> expected;
+        if (!points.empty()) {
+          const TetGrid part1 = grid_of(from.mesh(), labels);
+          for (const Vec3& p : points)
+            for (int t : tets_near(from.mesh(), part1, p, reach))
+              for (int v : from.mesh().tets[static_cast<size_t>(t)]) expected.push_back(v);
+          std::sort(expected.begin(), expected.end());
+          expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+        }
+        r.model = std::make_unique<HybridModel>(from, std::move(labels), held, make_cpu_solver(),
+                                                expected);
+        r.held_nodes = std::move(held);
+        const TetMesh& mesh = r.model->mesh();
+        const Partition& p = r.model->partition();
+        r.boundary.init(mesh, p.operation_tet);
+        r.cuttable = p.operation_tet;
+        r.locked.assign(mesh.nodes.size(), 0);
+        std::vector<std::uint8_t> condensed(p.operation_tet.size(), 0);
+        for (int t : p.condensed_tets) {
+          condensed[static_cast<size_t>(t)] = 1;
+          for (int v : mesh.tets[static_cast<size_t>(t)]) r.locked[static_cast<size_t>(v)] = 1;
+        }
+        r.cut_grid = grid_of(mesh, r.cuttable);
+        r.condensed_grid = grid_of(mesh, condensed);
+        r.ms = ms_since(t0);
+        return r;
+      });
 }
 
 bool RegionFollower::ready() const {

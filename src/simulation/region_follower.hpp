@@ -87,8 +87,11 @@ class RegionFollower {
   // keep_nodes: nodes that must stay O or I (imposed ones); held_nodes: every node of a free
   // piece (MovedRegion::held_nodes). A piece is anchored by fixed (or held) nodes only, never
   // by interface nodes: the interface is the old partition's, not the new one's.
+  // cut_points: where the next cut is expected (the waiting sweep's or the blade's samples):
+  // the new model's first factorization frames the nodes of part-1 tets near them, so that
+  // cut refactors a frame (HybridModel's expected_cut_nodes).
   void start(const HybridModel& from, const Vec3& centre, std::vector<int> keep_nodes,
-             std::vector<int> held_nodes, std::string reason);
+             std::vector<int> held_nodes, std::string reason, std::vector<Vec3> cut_points = {});
   bool moving() const { return work_.valid(); }
   bool ready() const;  // the worker has finished
   // The moved region (waits for the worker if needed); nullopt if it failed (the reason

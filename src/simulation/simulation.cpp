@@ -454,10 +454,13 @@ struct Simulation::Impl {
     return keep;
   }
 
-  void start_move(const Vec3& centre, std::string why) {
+  // cut_points: where the next cut is expected (the waiting sweep, or the blade): the new
+  // model's first factorization frames them, so that cut refactors a frame only.
+  void start_move(const Vec3& centre, std::string why, std::vector<Vec3> cut_points) {
     std::vector<int> piece_nodes = held_piece_nodes;  // and copies a cut made of held nodes
     for (const auto& h : held) piece_nodes.push_back(h.first);
-    follower->start(*model, centre, imposed_nodes(), std::move(piece_nodes), std::move(why));
+    follower->start(*model, centre, imposed_nodes(), std::move(piece_nodes), std::move(why),
+                    std::move(cut_points));
   }
 
   bool operation_or_interface(const HybridModel& m, int n) const {
@@ -596,7 +599,8 @@ struct Simulation::Impl {
                                                  sw.to.position - sw.from.position);
         if (follower->worth_moving_to(centre)) {
           ++sw.moves_tried;
-          start_move(centre, "the cut came within one element layer of the interface");
+          start_move(centre, "the cut came within one element layer of the interface",
+                     follower->sweep_points(a, b));
           if (wait) {  // offline: the sweep waits for nothing
             adopt_moved_region(s, true);
             continue;
@@ -651,9 +655,9 @@ struct Simulation::Impl {
     if (blade_state == BladeState::kCutting)
       for (auto p = stroke.rbegin(); p != stroke.rend() && motion.isZero(0); ++p)
         motion = blade->position - p->position;
-    const Vec3 centre =
-        follower->centre_for(*model, cut_state, follower->edge_points(edge), motion);
-    if (follower->worth_moving_to(centre)) start_move(centre, std::move(why));
+    const std::vector<Vec3> points = follower->edge_points(edge);
+    const Vec3 centre = follower->centre_for(*model, cut_state, points, motion);
+    if (follower->worth_moving_to(centre)) start_move(centre, std::move(why), points);
   }
 
   // `follow`, ~cut paths: the region moves (waiting for it) to hold each sweep before it is
@@ -666,7 +670,7 @@ struct Simulation::Impl {
     const Vec3 centre = follower->centre_for(*model, cut_state, follower->sweep_points(a, b),
                                              to.position - from.position);
     if (!follower->worth_moving_to(centre)) return;
-    start_move(centre, "a ~cut path left the region");
+    start_move(centre, "a ~cut path left the region", follower->sweep_points(a, b));
     settle_region_move();
   }
 

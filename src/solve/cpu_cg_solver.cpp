@@ -152,8 +152,17 @@ class CpuCgSolver final : public LinearSolver {
         if (k >= 0) changed->push_back(k);
       }
     }
+    std::optional<std::vector<int>> expected;
+    if (history.expected_rows) {
+      expected.emplace();
+      for (int r : *history.expected_rows) {
+        if (r < 0 || r >= a_.rows()) continue;
+        const int k = kept_.empty() ? r : kept_index_[static_cast<size_t>(r)];
+        if (k >= 0) expected->push_back(k);
+      }
+    }
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.interface_rows, previous, changed);
+      factor(same_rows, history.interface_rows, previous, changed, expected);
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -328,7 +337,8 @@ class CpuCgSolver final : public LinearSolver {
   // keeps a frame around what changed since `previous` (the last block); its first `interface`
   // rows are the dense interface block.
   void factor(bool same_rows, int interface, const SparseMatrix& previous,
-              const std::optional<std::vector<int>>& changed) {
+              const std::optional<std::vector<int>>& changed,
+              const std::optional<std::vector<int>>& expected) {
     const SparseMatrix& block = this->block();
     if (block.rows() == 0) {
       chol_.reset();
@@ -348,15 +358,16 @@ class CpuCgSolver final : public LinearSolver {
       }
     }
     std::vector<int> frame;
-    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows()) {
-      int dense = interface;
-      if (!kept_.empty())
-        dense = static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) -
-                                 kept_.begin());
+    int dense = interface;
+    if (!kept_.empty())
+      dense =
+          static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) - kept_.begin());
+    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows())
       frame = changed ? FramedCholesky::frame_around(block, *changed, dense, kFrameRings)
                       : FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
-      if (static_cast<int>(frame.size()) > max_frame(block.rows())) frame.clear();
-    }
+    else if (expected && !expected->empty())  // a fresh factor: frame where a cut is expected
+      frame = FramedCholesky::frame_around(block, *expected, dense, kFrameRings);
+    if (static_cast<int>(frame.size()) > max_frame(block.rows())) frame.clear();
     chol_.reset();
     active_ = "jacobi";
     try {

@@ -45,9 +45,13 @@ class HybridModel {
   // Starts at zero displacement: set_displacement() hands the current state over.
   // held_nodes: as set_held_nodes, but set before the hybrid matrix is first factored (a held
   // free piece makes that matrix singular: the factor must leave its DOFs out from the start).
+  // expected_cut_nodes: where the next cut is expected (the blade's waiting sweep): the first
+  // factorization frames their rows (LinearSolver::History::expected_rows), so that cut
+  // refactors a frame, not the whole hybrid matrix.
   HybridModel(const HybridModel& from, std::vector<std::uint8_t> operation_tet,
               const std::vector<int>& held_nodes = {},
-              std::unique_ptr<LinearSolver> solver = make_cpu_solver());
+              std::unique_ptr<LinearSolver> solver = make_cpu_solver(),
+              const std::vector<int>& expected_cut_nodes = {});
   ~HybridModel();
   HybridModel(const HybridModel&) = delete;
   HybridModel& operator=(const HybridModel&) = delete;
@@ -187,6 +191,8 @@ class HybridModel {
   // The rows a_ changed in since the solver last saw it (cuts' matrix updates); none: unknown
   // (a full assembly), the solver compares.
   mutable std::optional<std::vector<int>> rows_changed_;
+  // The constructor's expected_cut_nodes, until the first factorization frames their rows.
+  mutable std::vector<int> expected_cut_nodes_;
   void refresh_factor() const;
   ImposedDisplacements last_imposed_;
   std::unique_ptr<LinearSolver> solver_;

@@ -75,10 +75,15 @@ class LinearSolver {
   // may then refactor only what changed (cpu_cg_solver.cpp). Default: set_matrix(a, held).
   // `changed_rows`, when given, lists every row that may differ from the last matrix's (the
   // others are bit for bit the same): the solver need not compare them.
+  // `expected_rows`, when given: a factorization that cannot take `a` through its last frame
+  // (a fresh one: a moved region's new model) orders these rows and a ring around them last,
+  // as it orders the rows a cut changed, so the next cut there refactors that frame alone
+  // (docs/DESIGN.md section 6.2): where the next cut is expected.
   struct History {
     int kept_rows = 0;
     int interface_rows = 0;
     const std::vector<int>* changed_rows = nullptr;
+    const std::vector<int>* expected_rows = nullptr;
   };
   virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                           const History& history) {

@@ -204,6 +204,37 @@ TEST(FramedCholesky, TakesTheChangedRowsItIsTold) {
             f.frame);
 }
 
+// A fresh factorization told where the next change is expected (a moved region's new model,
+// LinearSolver::History::expected_rows) frames those rows: a change there then refactors the
+// frame alone, exactly; without the hint the same change refactors the whole matrix.
+TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
+  const Framed f = thigh_matrix();
+  const int n = static_cast<int>(f.a.rows());
+  const int p = n - 1;  // f.frame is this row and its neighbours
+  SparseMatrix changed = f.a;
+  changed.coeffRef(p, p) *= 1.25;
+  const std::vector<int> rows = {p};
+  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
+  const Vector ref = SparseCholesky(changed).solve(b);
+  for (const bool hint : {true, false}) {
+    auto solver = make_cpu_solver();
+    LinearSolver::History fresh;
+    fresh.interface_rows = f.dense;
+    if (hint) fresh.expected_rows = &rows;
+    solver->set_matrix(f.a, {}, fresh);
+    LinearSolver::History cut;
+    cut.kept_rows = n;
+    cut.interface_rows = f.dense;
+    cut.changed_rows = &rows;
+    solver->set_matrix(changed, {}, cut);
+    EXPECT_EQ(solver->frame_updates(), hint ? 1 : 0) << (hint ? "with" : "without") << " the hint";
+    Vector x = Vector::Zero(n);
+    const CgResult r = solver->solve(b, x, {}, CgSettings{1e-13, 50});
+    EXPECT_TRUE(r.converged);
+    EXPECT_LE((x - ref).norm() / ref.norm(), 1e-11);
+  }
+}
+
 TEST(FramedCholesky, RefusesChangesOutsideTheFrameAndKeepsItsFactor) {
   const Framed f = thigh_matrix();
   FramedCholesky factor(f.a, f.frame);
