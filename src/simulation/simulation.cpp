@@ -662,8 +662,11 @@ struct Simulation::Impl {
 
   // `follow`, ~cut paths: the region moves (waiting for it) to hold each sweep before it is
   // cut, so a path longer than the region cuts end to end.
+  // The blade's own waiting sweeps stay waiting (the steps cut them): settling them here, with
+  // every move they ask for awaited, held the loop for minutes when a ~cut came while a
+  // random-walking blade had queued thousands (the follow soak).
   void move_region_for_path_sweep(const BladePose& from, const BladePose& to) {
-    settle_region_move();
+    finish_region_move();
     const double length = scene.scalpel.blade_length;
     const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
     if (follower->sweep_fits(*model, cut_state, a, b)) return;
@@ -671,7 +674,15 @@ struct Simulation::Impl {
                                              to.position - from.position);
     if (!follower->worth_moving_to(centre)) return;
     start_move(centre, "a ~cut path left the region", follower->sweep_points(a, b));
-    settle_region_move();
+    finish_region_move();
+  }
+
+  // Waits for a running move and swaps it in; waiting sweeps stay waiting.
+  void finish_region_move() {
+    if (!follower || !follower->moving()) return;
+    StepStats s;
+    adopt_moved_region(s, true);
+    ++surface_version;
   }
 
   // Waits for a running move, swaps it in and cuts every waiting sweep (moving the region
