@@ -688,10 +688,10 @@ struct Simulation::Impl {
   // Waits for a running move, swaps it in and cuts every waiting sweep (moving the region
   // again as they need, waiting each time): offline callers, and before the mesh or E changes.
   void settle_region_move() {
-    if (!follower || (!follower->moving() && pending_sweeps.empty())) return;
+    finish_region_move();
+    if (!follower || pending_sweeps.empty()) return;
     StepStats s;
-    adopt_moved_region(s, true);
-    drain_sweeps(s, true);
+    drain_sweeps(s, true);  // may move the region again, waiting each time
     ++surface_version;
   }
 

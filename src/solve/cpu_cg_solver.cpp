@@ -143,24 +143,20 @@ class CpuCgSolver final : public LinearSolver {
     // them changed its held state: then a cut within the last frame refactors the frame alone.
     const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
                            held_mask_.head(old_rows) == old_held_mask;
-    // The rows changed since the factorization, in the block's numbering, when known.
-    std::optional<std::vector<int>> changed;
-    if (same_rows && history.changed_rows) {
-      changed.emplace();
-      for (int r : *history.changed_rows) {
-        const int k = kept_.empty() ? r : kept_index_[static_cast<size_t>(r)];
-        if (k >= 0) changed->push_back(k);
-      }
-    }
-    std::optional<std::vector<int>> expected;
-    if (history.expected_rows) {
-      expected.emplace();
-      for (int r : *history.expected_rows) {
+    // Rows of `a` in the block's numbering (held rows are not in the block).
+    auto block_rows = [this](const std::vector<int>& rows) {
+      std::vector<int> out;
+      for (int r : rows) {
         if (r < 0 || r >= a_.rows()) continue;
         const int k = kept_.empty() ? r : kept_index_[static_cast<size_t>(r)];
-        if (k >= 0) expected->push_back(k);
+        if (k >= 0) out.push_back(k);
       }
-    }
+      return out;
+    };
+    // The rows changed since the factorization, when known; where the next change is expected.
+    std::optional<std::vector<int>> changed, expected;
+    if (same_rows && history.changed_rows) changed = block_rows(*history.changed_rows);
+    if (history.expected_rows) expected = block_rows(*history.expected_rows);
     if (wanted_ == CgPreconditioner::kCholesky) {
       factor(same_rows, history.interface_rows, previous, changed, expected);
     } else {
