@@ -39,7 +39,16 @@ struct CutState {
   // different sweeps (a slow blade, a curved or twisting path) is still recognised as lying
   // on the cut (triangle_cut.cpp).
   std::vector<std::uint8_t> on_stroke;
+  // Per node (grown on demand): moved onto a border of a cut once (split_along_border); it
+  // is never moved there again.
+  std::vector<std::uint8_t> moved_to_border;
+  // Where the last band's tip and heel paths ended (cut_band conforms them from there).
+  std::array<Vec3, 2> border_from = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
   std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
+  // The last band's triangles (as inserted, margins included) and its front, the border the
+  // next band carries the cut on from; finish_stroke conforms the cut to it (cut_sweep.hpp).
+  std::vector<std::array<Vec3, 3>> last_band;
+  std::vector<std::array<Vec3, 2>> last_front;  // segments, each on triangle 2k + 1
 };
 
 // locked: per node (empty = none); cuttable: per tet (empty = all). Also sizes
@@ -53,6 +62,15 @@ inline bool is_on_stroke(const CutState& state, int v) {
 inline void set_on_stroke(CutState& state, int v) {
   if (state.on_stroke.size() <= static_cast<size_t>(v)) state.on_stroke.resize(v + 1, 0);
   state.on_stroke[v] = 1;
+}
+
+inline bool was_moved_to_border(const CutState& state, int v) {
+  return static_cast<size_t>(v) < state.moved_to_border.size() && state.moved_to_border[v];
+}
+inline void set_moved_to_border(CutState& state, int v) {
+  if (state.moved_to_border.size() <= static_cast<size_t>(v))
+    state.moved_to_border.resize(v + 1, 0);
+  state.moved_to_border[v] = 1;
 }
 
 // The tets that use both a and b, ascending.

@@ -19,7 +19,8 @@ long count_marked_face_sides(const TetMesh& mesh) {
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options,
-                        const std::vector<std::array<Vec3, 3>>& also_mark_in) {
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in,
+                        const std::vector<CutBorder>& borders, double skin_slack) {
   CutResult result;
   // A new stroke: no node is on its cut surface yet.
   if (also_mark_in.empty()) state.on_stroke.clear();
@@ -35,11 +36,19 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     hi = hi.cwiseMax(b);
   }
   // All splits first, then all marks (triangle_cut.hpp says why).
+  // The stroke's surface, nearest first (a face's corners are looked for in this order).
+  std::vector<std::array<Vec3, 3>> surface = triangles;
+  surface.insert(surface.end(), also_mark_in.rbegin(), also_mark_in.rend());
   for (auto& tri : cut) split_along_triangle(mesh, state, tri, options, result);
+  for (const CutBorder& border : borders)
+    if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
+      split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
+                         border.p1, options, surface, result);
   for (auto& tri : cut) {
     Vec3 a, b;
     tri.bounds(a, b);
-    mark_faces_on_triangle(mesh, state, tri, a, b, options, result, new_faces);
+    mark_faces_on_triangle(mesh, state, tri, a, b, options, surface, skin_slack, result,
+                           new_faces);
   }
   // Earlier triangles of the same stroke: a face that only now appears (this cut split the
   // tets around it) may lie in any of them. Such a face belongs to a tet this cut touched,
@@ -60,7 +69,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
       a = a.cwiseMax(touched_lo);
       b = b.cwiseMin(touched_hi);
       if ((a.array() > b.array()).any()) continue;  // no overlap
-      mark_faces_on_triangle(mesh, state, previous, a, b, options, result, new_faces);
+      mark_faces_on_triangle(mesh, state, previous, a, b, options, surface, skin_slack, result,
+                             new_faces);
     }
   }
   if (!triangles.empty()) {
@@ -109,8 +119,10 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     }
     margin = count ? options.front_margin_fraction * sum / count : 0;
   }
-  // Extended polylines: beyond tip and heel along the edge, ahead of the motion (and behind
-  // it where a stroke starts).
+  // Extended polylines: beyond tip and heel along the edge, and ahead of the motion. The
+  // band's borders in the tissue (the tip's and heel's paths, where a stroke starts) are
+  // conformed (split_along_border); its front is conformed when the stroke ends
+  // (finish_stroke), and until then the margin ahead lets the cut open close behind the blade.
   auto extend_ends = [margin](std::vector<Vec3> line) {
     const Vec3 down = line.front() - line[1], up = line.back() - line[line.size() - 2];
     if (down.norm() > 0) line.front() += margin * down.normalized();
@@ -122,18 +134,29 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     const Vec3 motion = b[i] - a[i];
     if (!(motion.norm() > 0)) continue;
     b[i] += margin * motion.normalized();
-    if (!continues) a[i] -= margin * motion.normalized();
   }
   // Each quad (a_i, a_i+1, b_i+1, b_i) as two triangles, tip side first as a single edge's
   // sweep (A0, B0, B1), (A0, B1, A1).
   std::vector<std::array<Vec3, 3>> sweep;
+  std::vector<CutBorder> borders;
   for (size_t i = 0; i + 1 < a.size(); ++i) {
+    const int first = static_cast<int>(sweep.size());
     sweep.push_back({a[i], a[i + 1], b[i + 1]});
     sweep.push_back({a[i], b[i + 1], b[i]});
+    if (!continues) borders.push_back({first, a[i], a[i + 1]});  // where the stroke starts
+  }
+  // The paths of the tip and the heel bound the band (from where the last band's paths
+  // ended, so they join); its front does not (the next step carries the cut on from there).
+  if (!continues) state.border_from = {a.front(), a.back()};
+  const Vec3 now[2] = {b.front(), b.back()};
+  const int tri[2] = {1, static_cast<int>(sweep.size()) - 2};
+  for (int e = 0; e < 2; ++e) {
+    borders.push_back({tri[e], state.border_from[e], now[e]});
+    state.border_from[e] = now[e];
   }
   const std::vector<std::array<Vec3, 3>> none;
   CutResult result =
-      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none);
+      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none, borders);
   // The stroke so far: every non-degenerate sweep triangle since the blade began this
   // continuous cut, so that faces spanning many small sweeps (a blade moving 1 mm per step
   // through 6 mm tets) are still opened. Bounded so a very long stroke stays cheap.
@@ -145,7 +168,27 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     state.last_sweep.erase(state.last_sweep.begin(),
                            state.last_sweep.end() - static_cast<long>(kMaxStrokeTriangles));
   state.last_sweep_end = {to.front(), to.back()};
+  state.last_band = sweep;
+  state.last_front.clear();
+  // Where the blade's edge is (the margin ahead of it is for the next band): the cut ends there.
+  const std::vector<Vec3> front = extend_ends(to);
+  for (size_t i = 0; i + 1 < front.size(); ++i)
+    state.last_front.push_back({front[i], front[i + 1]});
   return result;
+}
+
+CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& options) {
+  if (state.last_band.empty()) return {};
+  std::vector<CutBorder> front;
+  for (size_t i = 0; i < state.last_front.size(); ++i)
+    front.push_back({static_cast<int>(2 * i + 1), state.last_front[i][0], state.last_front[i][1]});
+  const std::vector<std::array<Vec3, 3>> band = std::move(state.last_band);
+  state.last_band.clear();
+  // The band's own triangles again: its tets are split already, so only the front's are new.
+  // No skin slack here: the front is where the blade stopped, and a face reaching past it at
+  // the skin would open the tissue ahead of the blade (the end of a curved stroke on a fine
+  // liver: open faces 4 x the tolerance past the sweep with it, within tolerance without).
+  return cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0);
 }
 
 }  // namespace stc

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "cutting/cut_state.hpp"
+#include "cutting/triangle_cut.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
 
@@ -25,12 +26,30 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
 CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from,
                    const std::vector<Vec3>& to, const CutOptions& options = {});
 
+// A segment of the cut surface's border (the tip's path, the heel's, where a stroke starts),
+// lying on triangle `triangle` of a cut_triangles call.
+struct CutBorder {
+  int triangle = 0;
+  Vec3 p0, p1;
+};
+
+// The end of a stroke (the blade stops, leaves the tissue, or stops cutting): the cut is
+// conformed to the last band's front as it is to the tip's and heel's paths at every step, so
+// it opens up to where the blade stopped, not an element short of it. Nothing to do if no band
+// was cut since the last call; the stroke may go on afterwards.
+CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& options = {});
+
 // Any list of planar triangles, inserted as one cut (one separation at the end).
 // also_mark_in: earlier triangles of the same stroke; faces this cut creates that lie in one of
 // them are marked too (the split around a new triangle can expose a face of an old one).
+// borders: where the cut surface ends inside the tissue; the faces on the cut are split there
+// (split_along_border) so that the cut opens up to them.
+// skin_slack: as mark_faces_on_triangle's (triangle_cut.hpp).
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options = {},
-                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {});
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
+                        const std::vector<CutBorder>& borders = {},
+                        double skin_slack = kSkinCornerSlack);
 
 }  // namespace stc

@@ -1,6 +1,7 @@
 #include "cutting/triangle_cut.hpp"
 
 #include "cutting/edge_bisection.hpp"
+#include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
@@ -9,6 +10,55 @@
 
 namespace stc {
 namespace {
+
+// How far (in units of its longest edge) a face marked on the cut may lie off the stroke's
+// surface: its centroid off the triangle's plane, its corners off every triangle of the stroke.
+constexpr double kOnCutSlack = 0.25;
+
+// A crossing this near an end of its edge (a fraction of the edge) puts that end on the cut
+// as it is: it is not moved there.
+constexpr double kNegligibleMove = 1e-3;
+
+// Is x within `slack` of one of the stroke's triangles?
+bool near_surface(const Vec3& x, const std::vector<std::array<Vec3, 3>>& surface, double slack) {
+  for (const auto& s : surface) {
+    const Vec3 lo = s[0].cwiseMin(s[1]).cwiseMin(s[2]).array() - slack,
+               hi = s[0].cwiseMax(s[1]).cwiseMax(s[2]).array() + slack;
+    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+    Vec3 w;
+    if ((closest_point_on_triangle(x, s[0], s[1], s[2], w) - x).norm() <= slack) return true;
+  }
+  return false;
+}
+
+// Is the stroke's surface flat where it meets the box [lo, hi]: every triangle of it there
+// within 10 deg of `normal`? (A straight stroke's is; a curved, tilted one's turns.)
+bool flat_within(const std::vector<std::array<Vec3, 3>>& surface, const Vec3& normal,
+                 const Vec3& lo, const Vec3& hi) {
+  const double cos_limit = std::cos(10.0 * M_PI / 180.0);
+  for (const auto& s : surface) {
+    const Vec3 a = s[0].cwiseMin(s[1]).cwiseMin(s[2]), b = s[0].cwiseMax(s[1]).cwiseMax(s[2]);
+    if ((b.array() < lo.array()).any() || (a.array() > hi.array()).any()) continue;
+    const Vec3 n = (s[1] - s[0]).cross(s[2] - s[0]);
+    if (!(n.squaredNorm() > 0)) continue;
+    if (std::abs(n.normalized().dot(normal)) < cos_limit) return false;
+  }
+  return true;
+}
+
+// Is node v on the mesh's boundary (a face of one of its tets with no neighbour)?
+bool on_boundary(const TetMesh& mesh, const CutState& state, int v) {
+  for (int t : state.node_tets[v])
+    for (int f = 0; f < 4; ++f)
+      if (mesh.tets[t][f] != v && neighbour_across(mesh, state, t, f).first < 0) return true;
+  return false;
+}
+
+// Where a point meets a border segment's line or ends, as a fraction of the segment's length:
+// well above round-off, so a blade placed exactly on the mesh's nodes or grid lines (a
+// structured mesh, a scripted path) is not decided by noise - the same cut whatever the
+// solver's last digits.
+constexpr double kOnBorderSlack = 1e-6;
 
 // The six edges of a tet as local vertex pairs.
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
@@ -178,18 +228,31 @@ std::pair<int, int> neighbour_across(const TetMesh& mesh, const CutState& state,
 }
 
 void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification& tri,
-                          const CutOptions& options, CutResult& result) {
+                          const CutOptions& options, CutResult& result,
+                          const std::vector<int>& whole) {
   if (tri.degenerate()) return;
   // Every tet with a crossing edge inside the triangle overlaps its box.
   Vec3 lo, hi;
   tri.bounds(lo, hi);
-  const std::vector<int> candidates = cuttable_tets_in(mesh, state, lo, hi);
+  std::vector<int> candidates = cuttable_tets_in(mesh, state, lo, hi);
+  if (!whole.empty()) {
+    // Their edges may cross the plane outside the triangle's box, so every tet around them
+    // (all of which a bisection of such an edge splits) is a candidate, for the volume guard.
+    for (int t : whole)
+      for (int v : mesh.tets[t])
+        for (int k : state.node_tets[v])
+          if (state.cuttable[k]) candidates.push_back(k);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  }
 
   // (b) Crossing edges inside the triangle. The volume guard may snap an end to "on", which
   // only removes crossing edges, so the loop ends.
   std::map<std::pair<int, int>, double> crossing;
+  std::set<std::pair<int, int>> beyond;  // crossing outside the triangle (`whole` tets)
   for (;;) {
     crossing.clear();
+    beyond.clear();
     bool resnap = false;
     for (int t : candidates) {
       const Tet& tet = mesh.tets[t];
@@ -201,29 +264,37 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         if (state.locked[u] && state.locked[v]) continue;  // interface edges stay whole
         const double du = tri.distance(mesh, u), dv = tri.distance(mesh, v);
         const double s = du / (du - dv);
-        if (!tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
-                          options.inside_tolerance))
-          continue;
+        // Outside the triangle (an edge of a `whole` tet): its node is on this triangle's
+        // plane but not on the stroke's cut surface, which ends at the border.
+        const bool outside = !tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
+                                           options.inside_tolerance);
+        if (outside && !std::binary_search(whole.begin(), whole.end(), t)) continue;
+        auto put_on = [&](int node) {
+          tri.set_on(node);
+          if (!outside) set_on_stroke(state, node);
+        };
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
-        // Near an end: move that end onto the cut if it may move (relocate_node).
-        if (s < options.relocate || s > 1 - options.relocate) {
+        // Near an end: move that end onto the cut if it may move (relocate_node) - unless it
+        // is on it but for round-off (moving it would only trade planes with a neighbouring
+        // triangle of the stroke, again at every pass).
+        if ((s < options.relocate || s > 1 - options.relocate) &&
+            std::min(s, 1 - s) > kNegligibleMove) {
           const int end = s < 0.5 ? u : v;
           if (relocate_node(mesh, state, end, mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
                             options, result)) {
-            tri.set_on(end);
-            set_on_stroke(state, end);
+            put_on(end);
             resnap = true;
             continue;
           }
         }
         if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
-          tri.set_on(s < 0.5 ? u : v);
-          set_on_stroke(state, s < 0.5 ? u : v);
+          put_on(s < 0.5 ? u : v);
           resnap = true;
           continue;
         }
         crossing[{u, v}] = s;
+        if (outside) beyond.insert({u, v});
       }
     }
     if (resnap) continue;
@@ -245,12 +316,14 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
       // Too small a piece: snap the end nearest the plane among this tet's crossing edges.
       int nearest = -1;
       double best = 2.0;
+      bool outside = false;
       for (const Split& s : splits) {
-        if (s.t < best) best = s.t, nearest = s.a;
-        if (1 - s.t < best) best = 1 - s.t, nearest = s.b;
+        const bool beyond_here = beyond.count({s.a, s.b}) > 0;
+        if (s.t < best) best = s.t, nearest = s.a, outside = beyond_here;
+        if (1 - s.t < best) best = 1 - s.t, nearest = s.b, outside = beyond_here;
       }
       tri.set_on(nearest);
-      set_on_stroke(state, nearest);
+      if (!outside) set_on_stroke(state, nearest);
       snapped = true;
     }
     if (!snapped) break;
@@ -258,6 +331,143 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 
   // Bisect in (a, b) order, so each tet is cut into exactly the pieces the guard checked.
   for (const auto& [edge, t] : crossing) {
+    const size_t before = result.changed_tets.size();
+    const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
+    result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
+    tri.set_on(m);
+    if (!beyond.count(edge)) set_on_stroke(state, m);
+    NewNode node;
+    node.index = m;
+    node.kind = NewNode::Kind::kEdgeSplit;
+    node.a = edge.first;
+    node.b = edge.second;
+    node.t = t;
+    result.new_nodes.push_back(node);
+  }
+}
+
+void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& tri, const Vec3& p0,
+                        const Vec3& p1, const CutOptions& options,
+                        const std::vector<std::array<Vec3, 3>>& surface, CutResult& result) {
+  if (tri.degenerate()) return;
+  const Vec3 along = p1 - p0;
+  const double length2 = along.squaredNorm();
+  if (!(length2 > 0)) return;
+  // In the triangle's plane, perpendicular to the border.
+  const Vec3 across = tri.normal().cross(along).normalized();
+  const Vec3 pad = Vec3::Constant(1e-6 * std::sqrt(length2));
+  auto along_segment = [&](const Vec3& x) {
+    const double s = along.dot(x - p0) / length2;
+    return s >= -kOnBorderSlack && s <= 1 + kOnBorderSlack;
+  };
+  // (a) The tets the segment runs through: the points where the plane crosses their edges lie
+  // on both sides of the border, and one of them beside the segment.
+  std::vector<int> whole;
+  const double sweep_side = across.dot(tri.centroid() - p0);
+  for (int t : cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad)) {
+    bool inside = false, outside = false, beside = false, on_surface = true;
+    const Tet& tet = mesh.tets[t];
+    double longest = 0;
+    for (const auto& e : kTetEdges)
+      longest = std::max(longest, (mesh.nodes[tet[e[0]]] - mesh.nodes[tet[e[1]]]).norm());
+    Vec3 tet_lo, tet_hi;
+    tet_bounds(mesh, t, tet_lo, tet_hi);
+    for (const auto& e : kTetEdges) {
+      const int u = tet[e[0]], v = tet[e[1]];
+      const int su = tri.side(mesh, state, u), sv = tri.side(mesh, state, v);
+      Vec3 x;
+      if (su == 0)
+        x = mesh.nodes[u];
+      else if (sv == 0)
+        x = mesh.nodes[v];
+      else if (su * sv == -1) {
+        const double du = tri.distance(mesh, u), dv = tri.distance(mesh, v);
+        x = mesh.nodes[u] + du / (du - dv) * (mesh.nodes[v] - mesh.nodes[u]);
+      } else {
+        continue;
+      }
+      // A point on the border's line up to round-off (a node a split put there) is on neither
+      // side: its sign would be noise, and decide the tet's cut by it.
+      const double d = across.dot(x - p0), on_line = kOnBorderSlack * std::sqrt(length2);
+      inside = inside || d < -on_line;
+      outside = outside || d > on_line;
+      beside = beside || along_segment(x);
+      if (d * sweep_side > 0 && on_surface)
+        on_surface = near_surface(x, surface, kOnCutSlack * longest) ||
+                     flat_within(surface, tri.normal(), tet_lo, tet_hi);
+    }
+    if (inside && outside && beside && on_surface) whole.push_back(t);
+  }
+  std::sort(whole.begin(), whole.end());
+  if (!whole.empty()) split_along_triangle(mesh, state, tri, options, result, whole);
+  // (b) The edges on the cut that cross the segment.
+  const std::vector<int> candidates =
+      cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
+  std::map<std::pair<int, int>, double> crossing;
+  for (int t : candidates) {
+    const Tet& tet = mesh.tets[t];
+    for (const auto& e : kTetEdges) {
+      const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
+      if (crossing.count({u, v})) continue;
+      if (state.locked[u] && state.locked[v]) continue;
+      if (tri.side(mesh, state, u) != 0 || tri.side(mesh, state, v) != 0) continue;
+      const double du = across.dot(mesh.nodes[u] - p0), dv = across.dot(mesh.nodes[v] - p0);
+      // An end on the border's line up to round-off is on the border already (an edge along
+      // the line would otherwise "cross" it where its ends' noise signs differ).
+      const double on_line = kOnBorderSlack * std::sqrt(length2);
+      if (std::abs(du) <= on_line || std::abs(dv) <= on_line || !(du * dv < 0)) continue;
+      const double s = du / (du - dv);
+      if (std::min(s, 1 - s) <= kNegligibleMove) continue;  // an end is on the border already
+      const Vec3 x = mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]);
+      if (!along_segment(x)) continue;
+      // Near an end: move that end onto the border rather than cut a sliver, as in phase 1
+      // (it stays on the cut: x lies on the edge, which lies on the cut). A node moves onto a
+      // border once: a later stroke along the same path (a repeated ~cut, its rest position
+      // carried through a slightly different deformation) would otherwise move it again by a
+      // few micrometres at every pass, a change that never settles.
+      const int end = s < 0.5 ? u : v;
+      if ((s < options.relocate || s > 1 - options.relocate) && !was_moved_to_border(state, end) &&
+          relocate_node(mesh, state, end, x, options, result)) {
+        set_moved_to_border(state, end);
+        continue;
+      }
+      if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) continue;
+      crossing[{u, v}] = s;
+    }
+  }
+  // The volume guard: drop the crossing nearest an end in any tet it would thin too much
+  // (such a face is left whole: the border then runs along its nearer edge or vertex).
+  for (bool dropped = true; dropped && !crossing.empty();) {
+    dropped = false;
+    for (int t : candidates) {
+      std::vector<Split> splits;
+      const Tet& tet = mesh.tets[t];
+      for (const auto& e : kTetEdges) {
+        const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
+        auto it = crossing.find({u, v});
+        if (it != crossing.end()) splits.push_back({u, v, it->second});
+      }
+      if (splits.empty()) continue;
+      std::sort(splits.begin(), splits.end(), [](const Split& x, const Split& y) {
+        return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
+      });
+      if (smallest_piece(mesh, tet, splits) >= options.min_volume_fraction * state.origin_volume[t])
+        continue;
+      const Split* worst = &splits.front();
+      for (const Split& x : splits)
+        if (std::min(x.t, 1 - x.t) < std::min(worst->t, 1 - worst->t)) worst = &x;
+      crossing.erase({worst->a, worst->b});
+      dropped = true;
+    }
+  }
+  // Edges the other tets of the candidates' stars share are split there too (bisect_edge
+  // splits every tet on the edge), so each such tet must pass the guard as well.
+  for (const auto& [edge, t] : crossing) {
+    bool fits = true;
+    for (int k : tets_with_edge(state, edge.first, edge.second))
+      fits = fits && smallest_piece(mesh, mesh.tets[k], {Split{edge.first, edge.second, t}}) >=
+                         options.min_volume_fraction * state.origin_volume[k];
+    if (!fits) continue;
     const size_t before = result.changed_tets.size();
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
@@ -275,6 +485,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 
 void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri,
                             const Vec3& lo, const Vec3& hi, const CutOptions& options,
+                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
                             CutResult& result, std::set<FaceKey>& new_faces) {
   if (tri.degenerate()) return;
   // (c) Faces on the cut: three "on" nodes, centroid inside the triangle, tets on opposite
@@ -292,7 +503,8 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
       // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
-      // vertex that is itself on the cut says nothing.
+      // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
+      // it loose, separation keeps it attached, separation.cpp).
       const int here = tri.side(mesh, state, tet[f]);
       const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
       if (here != 0 && there != 0 && here == there) continue;
@@ -304,9 +516,21 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       const Vec3 n = (xq - xp).cross(xr - xp);
       const double longest = std::max({(xq - xp).norm(), (xr - xq).norm(), (xp - xr).norm()});
       if (std::abs(tri.normal().dot(centroid - mesh.nodes[p]) + tri.distance(mesh, p)) >
-          0.25 * longest)
+          kOnCutSlack * longest)
         continue;
       if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) continue;
+      // Its corners too, on the stroke's surface up to the same slack: the centroid alone
+      // would open a face that reaches well past a border of the sweep.
+      const double slack = kOnCutSlack * longest;
+      // A corner on the tissue's boundary may lie skin_slack times farther: there the cut
+      // breaks through the skin, and the blade's edge carried to rest coordinates outside the
+      // tissue is extrapolated (rest_mapping.hpp), so the stroke's surface only approximates
+      // where the blade crossed the skin.
+      auto corner_ok = [&](int v, const Vec3& x) {
+        return near_surface(x, surface, slack) ||
+               (on_boundary(mesh, state, v) && near_surface(x, surface, skin_slack * slack));
+      };
+      if (!corner_ok(p, xp) || !corner_ok(q, xq) || !corner_ok(r, xr)) continue;
       if (!state.cuttable[other]) {  // the blade stops at the condensed part
         result.reached_interface = true;
         continue;

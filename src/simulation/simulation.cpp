@@ -71,6 +71,7 @@ struct Simulation::Impl {
   std::deque<Sweep> pending_sweeps;
   std::vector<int> held_piece_nodes;  // `follow`: every node of a held free piece
   CutState cut_state;
+  bool stroke_to_finish = false;  // the blade cut since its stroke's end was conformed
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
@@ -167,6 +168,7 @@ struct Simulation::Impl {
     contact.release();
     last_pose.reset();
     stroke.clear();
+    stroke_to_finish = false;
     last_cut_pose.reset();
     last_rest_edge.clear();
     blade_imposed.clear();
@@ -251,17 +253,19 @@ struct Simulation::Impl {
   bool cut(const BladePose& from, const BladePose& to, StepStats& s,
            const DeformedToRest* frozen = nullptr) {
     const double length = scene.scalpel.blade_length;
+    constexpr int kSamples = 9;  // edge points carried; kept only where the map bends
+    const bool continues = last_cut_pose && last_cut_pose->position == from.position &&
+                           last_cut_pose->orientation.coeffs() == from.orientation.coeffs() &&
+                           last_rest_edge.size() == static_cast<size_t>(kSamples);
+    // A new stroke: the last one's end is conformed first if no step has done it yet.
+    const bool finished = !continues && stroke_to_finish && finish_cut_stroke(s);
     auto t0 = Clock::now();
     const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
     std::shared_ptr<DeformedToRest> built;
     if (!frozen) built = current_to_rest();
     const DeformedToRest& to_rest = frozen ? *frozen : *built;
-    constexpr int kSamples = 9;  // edge points carried; kept only where the map bends
     std::vector<double> params(kSamples);
     for (int i = 0; i < kSamples; ++i) params[i] = static_cast<double>(i) / (kSamples - 1);
-    const bool continues = last_cut_pose && last_cut_pose->position == from.position &&
-                           last_cut_pose->orientation.coeffs() == from.orientation.coeffs() &&
-                           last_rest_edge.size() == static_cast<size_t>(kSamples);
     std::optional<std::vector<Vec3>> rest_from =
         continues ? std::optional<std::vector<Vec3>>(last_rest_edge)
                   : to_rest.map_edge(a.tip, a.heel, params);
@@ -295,16 +299,32 @@ struct Simulation::Impl {
     last_rest_edge = rest_to ? *rest_to : std::vector<Vec3>{};
     if (!rest_from || !rest_to) {  // the edge never meets the operation part
       s.cutting_ms += ms_since(t0);
-      return false;
+      return finished;
     }
     const std::vector<int> keep = simplify_polylines(*rest_from, *rest_to, 0.25e-3);
     std::vector<Vec3> band_from, band_to;
     for (int k : keep) band_from.push_back((*rest_from)[k]), band_to.push_back((*rest_to)[k]);
     const CutResult r = cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to);
     s.cutting_ms += ms_since(t0);
+    return adopt_cut(r, s) || finished;
+  }
+
+  // The stroke ended (the blade left the tissue or its incision, was removed, a new stroke
+  // began, or a ~cut path ended): the cut is conformed to where the blade stopped
+  // (cut_sweep.hpp).
+  bool finish_cut_stroke(StepStats& s) {
+    stroke_to_finish = false;
+    const auto t0 = Clock::now();
+    const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state);
+    s.cutting_ms += ms_since(t0);
+    return adopt_cut(r, s);
+  }
+
+  // The model after a cut changed the mesh; returns whether it did.
+  bool adopt_cut(const CutResult& r, StepStats& s) {
     s.reached_interface |= r.reached_interface;
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     ++mesh_version;
     model->update_operation_part(r.changed_tets, r.new_nodes);
     boundary.update(model->mesh(), r.changed_tets);
@@ -729,6 +749,7 @@ struct Simulation::Impl {
         cut(*last_pose, blade, s);
       else
         pending_sweeps.push_back({*last_pose, blade});
+      stroke_to_finish = true;
     }
     stroke.push_back(blade);
     if (retracing || !edge_inside_tissue(edge)) {
@@ -781,6 +802,16 @@ struct Simulation::Impl {
       s.region_moving = follower->moving();
       s.collision_ms += ms_since(t0) - (s.cutting_ms + s.assembly_ms - cut_ms);
     }
+    // A stroke that ended (the blade left the tissue or its incision, or was removed) opens
+    // up to where the blade stopped: after its queued sweeps, and never while a region move is
+    // under way (the worker's copy of the mesh is swapped in with only the queued sweeps
+    // replayed; the stroke is finished after the swap). A step that cut already leaves it to
+    // the next (one model update per step: the slowest organ step was a cut and a finish,
+    // 30 ms); a new stroke finishes it first (cut()). Not on a pause: how many steps a blade
+    // is held still depends on timing (a bag replayed through the node), and the cut must not.
+    if (stroke_to_finish && !s.cutting && blade_state != BladeState::kCutting &&
+        (!follower || (pending_sweeps.empty() && !follower->moving())))
+      finish_cut_stroke(s);
     s.converged = solve(imposed, s);
     if (!imposed.empty()) {
       s.in_contact = true;
@@ -883,6 +914,7 @@ void Simulation::cut_path_slice(PathCut& cut, Clock::time_point deadline) {
     StepStats s;
     if (impl_->follower) impl_->move_region_for_path_sweep(from, to);
     changed |= impl_->cut(from, to, s, cut.to_rest.get());
+    if (cut.next + 1 == cut.poses.size()) changed |= impl_->finish_cut_stroke(s);  // its end
     cut.tets_split += s.tets_split;
     cut.nodes_added += s.nodes_added;
     cut.reached_interface |= s.reached_interface;

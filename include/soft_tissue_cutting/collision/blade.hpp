@@ -18,4 +18,7 @@ BladeEdge blade_edge(const BladePose& pose, double blade_length);
 // Closest point of segment [a, b] to p.
 Vec3 closest_point_on_segment(const Vec3& a, const Vec3& b, const Vec3& p);
 
+// Closest point of triangle (a, b, c) to p; w: its barycentric weights.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3& w);
+
 }  // namespace stc

@@ -46,10 +46,10 @@ struct CutOptions {
   double inside_tolerance = 1e-9;
   // The swept band is extended by this much beyond the blade's tip and heel and ahead of its
   // motion (m; negative = front_margin_fraction of the mean edge length of the tets the band
-  // meets). A crack front inside a tet cannot open (its nodes' stars stay connected), so
-  // without a margin every front - the tip's path, the blade's leading edge - stays closed up
-  // to a whole element short of where the blade is; with it, the cut opens to within about
-  // the margin of the blade either way.
+  // meets). A crack front inside a tet cannot open (its nodes' stars stay connected). The
+  // tip's and heel's paths are conformed at every step (the tets they run through are split
+  // along them), the blade's leading edge when the stroke ends (finish_stroke); between steps
+  // the margin ahead lets the opening follow the blade to within about an element.
   double front_margin = -1;
   double front_margin_fraction = 0.25;
 };

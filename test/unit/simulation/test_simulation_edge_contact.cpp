@@ -339,20 +339,20 @@ void belly_cut_opens_the_swept_area(const TestScene& t, double opened_fraction, 
   EXPECT_GT(b.cut_steps, 10) << what;
   EXPECT_GT(b.swept, 5e-5) << what;  // > 50 mm^2: a real incision
   // The issue asks >= 90 % of the swept area; how much of a sweep opens is the cut
-  // insertion's fidelity (cutting/, docs/DESIGN.md section 8). The liver meets it (111 %
-  // measured); the thigh's skin nodes are 8 mm apart and its operation tets ~1.3 cm, so the
-  // tets the heel's path and the stroke's end run through are cut part way and stay closed
-  // (66 % measured): asserted at what it opens today, so a regression in contact, yield or
-  // insertion shows.
+  // insertion's fidelity (cutting/, docs/DESIGN.md section 8). The thigh's operation tets are
+  // ~1.3 cm against a 1 cm deep cut: the cut's borders (the heel's path, where the stroke
+  // starts and ends) are conformed, or the tets they run through stay closed (66 % before).
   EXPECT_GE(b.opened, opened_fraction * b.swept) << what;
-  EXPECT_LE(b.opened, 1.2 * b.swept) << what;  // and not beyond the sweep
+  // And not far beyond the sweep: the coarse liver's faces are ~1 cm2 against a 2 cm2 sweep,
+  // so whole faces along the conformed borders open up to 1.4 x (140 % measured).
+  EXPECT_LE(b.opened, 1.5 * b.swept) << what;
 }
 
 TEST(SimulationEdgeContact, BellyCutWithTheTipOutsideOpensTheThigh) {
-  belly_cut_opens_the_swept_area(thigh(), 0.6, "thigh");
+  belly_cut_opens_the_swept_area(thigh(), 0.9, "thigh");  // 118 % measured
 }
 TEST(SimulationEdgeContact, BellyCutWithTheTipOutsideOpensTheLiver) {
-  belly_cut_opens_the_swept_area(liver(), 0.9, "liver");
+  belly_cut_opens_the_swept_area(liver(), 0.9, "liver");  // 139 % measured
 }
 
 TEST(SimulationEdgeContact, LiftingOutOrSlidingInItsOwnIncisionStopsCuttingAFreshPressCutsAgain) {
@@ -375,10 +375,16 @@ TEST(SimulationEdgeContact, LiftingOutOrSlidingInItsOwnIncisionStopsCuttingAFres
   for (int k = 1; k <= 24; ++k) lift.push_back(laid(t.site, 0.6, -4e-3 + 5e-4 * k, -0.005));
   EXPECT_GT(run(press) + run(draw), 5);
   EXPECT_FALSE(sim.blade_path().empty());  // still cutting
+  // Back: the stroke ends once the blade retraces its incision, and its end is conformed
+  // (the front where the blade stopped, a few dozen tets); then the slide cuts nothing.
+  size_t k = 0;
+  for (; k < back.size() && !sim.blade_path().empty(); ++k) run({back[k]});
+  EXPECT_LE(k, 3u) << "the stroke should end within the first steps back";
+  run({back[k++]});  // the step that conforms the stroke's end
   const int tets = sim.counts().tets;
-  run(back);
+  run(std::vector<BladePose>(back.begin() + static_cast<long>(k), back.end()));
   EXPECT_TRUE(sim.blade_path().empty()) << "sliding through its own incision still cuts";
-  EXPECT_LE(sim.counts().tets - tets, 8);     // at most a few tets at the start of the slide
+  EXPECT_LE(sim.counts().tets - tets, 8);     // nothing more while it slides
   EXPECT_FALSE(sim.last_stats().in_contact);  // the incision walls are never held
   run(lift);
   EXPECT_TRUE(sim.blade_path().empty());
