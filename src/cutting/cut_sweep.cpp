@@ -47,8 +47,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   for (auto& tri : cut) {
     Vec3 a, b;
     tri.bounds(a, b);
-    mark_faces_on_triangle(mesh, state, tri, a, b, options, surface, skin_slack, result,
-                           new_faces);
+    mark_faces_on_triangle(mesh, state, tri, a, b, options, surface, skin_slack, result, new_faces);
   }
   // Earlier triangles of the same stroke: a face that only now appears (this cut split the
   // tets around it) may lie in any of them. Such a face belongs to a tet this cut touched,

@@ -369,13 +369,18 @@ void report(const char* name, const Simulation& sim, const StrokeResult& r) {
       r.max_gap * 1e3, r.error_vs_full);
 }
 
-// The thigh (whole tube refined, 14 cm long), a 2.5 cm ball: a 10 cm incision along it,
+// The thigh (whole tube refined, 14 cm long), a 3 cm ball: a 10 cm incision along it,
 // against the same stroke with `operation_region: all` (nothing condensed, nothing moves):
 // the moves must cost no cut area and leave no gap that the cutter alone does not leave.
+// Why 3 cm and not kThighFollowYaml's 2.5: the blade's edge is 12 mm deep, and a 2.5 cm ball
+// less its uncut element layer leaves the heel's path at the edge of what can be cut, so the
+// conformed borders there stay unconformed (86 % opened offline, a 10.6 mm gap; checked at
+// the end); at 3 cm the moves cost nothing against `all`, and the region moves less often.
 TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   test::TempDir dir;
   const std::string path = test::write_file(dir.file("s.yaml"), kThighFollowYaml);
-  const Scene scene = load_scene(path);
+  Scene scene = load_scene(path);
+  scene.operation_region.sphere.radius = 0.03;
   const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // edge radially out (+x)
   std::vector<BladePose> poses;
   const double x_in = 0.06 - 0.012;
@@ -394,16 +399,11 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   const StrokeResult b = play_stroke(reference, poses, Vec3::UnitZ(), 0.03, 0.11);
   report("thigh 10 cm stroke, all (no moves)", reference, b);
   // Against the area swept inside the tissue as it hangs: issue 16 asks 90 %. With `all` the
-  // conformed borders (docs/DESIGN.md section 8, "Borders") open 109 % of this stroke; with
-  // moves awaited 86 % (85 % before the borders): near the moving interface a border tet
-  // touching the uncut layer is not conformed, and what the next move frees is cut by later
-  // sweeps, not by the one that passed. Online, below, 98 %.
-  EXPECT_GE(r.opened, 0.75 * b.opened);
-  EXPECT_GE(r.opened, 0.8 * r.swept);
-  // The largest gap between opened faces along the stroke: `all` 4.1 mm, moves awaited 10.6
-  // mm (4.1 before the borders: where a move leaves a border unconformed, the faces there
-  // stay closed). Under one operation tet (~13 mm): a hole of a whole element would show.
-  EXPECT_LE(r.max_gap, std::max(b.max_gap + 0.003, 0.011));
+  // conformed borders (docs/DESIGN.md section 8, "Borders") open 109 % of this stroke, with
+  // moves awaited 110 %.
+  EXPECT_GE(r.opened, 0.9 * b.opened);
+  EXPECT_GE(r.opened, 0.9 * r.swept);
+  EXPECT_LE(r.max_gap, b.max_gap + 0.003);  // no gap at the moves beyond the cutter's own
   EXPECT_LT(r.error_vs_full, 1e-9);
   EXPECT_LT(b.error_vs_full, 1e-9);
   // Not the same mesh as `all` any more: a cut is carried to rest coordinates through the
@@ -418,7 +418,10 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   const StrokeResult o = play_stroke(online, poses, Vec3::UnitZ(), 0.03, 0.11);
   report("thigh 10 cm stroke, follow online", online, o);
   EXPECT_GE(o.moves, 3);
-  EXPECT_GE(o.opened, 0.75 * b.opened);
+  // Unpaced (steps back to back: the blade crosses the 10 cm in about a second while a move
+  // takes ~0.1 s), so how much waits for each move depends on the machine's load: 83-102 %
+  // of the swept area over six runs (the paced run below: 109-114 %).
+  EXPECT_GE(o.opened, 0.75 * r.swept);
   EXPECT_LT(o.error_vs_full, 1e-9);
   // Online with no cutting budget: each step cuts one run of waiting sweeps at most, and the
   // step that swaps a moved region in cuts none (they are cut through the new model's own
@@ -450,9 +453,20 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
       swaps, swaps_cutting, cutting_steps, paced_opened * 1e4, paced_error);
   EXPECT_GE(swaps, 3);
   EXPECT_EQ(swaps_cutting, 0);
-  EXPECT_GE(paced_opened, 0.9 * r.swept);  // issue 16's 90 % (95 % measured)
+  EXPECT_GE(paced_opened, 0.9 * r.swept);  // issue 16's 90 % (109-114 % measured)
   EXPECT_TRUE(test::spec6_violations(paced).empty());
   EXPECT_LT(paced_error, 1e-9);
+  // The 2.5 cm ball (kThighFollowYaml, config/scenes/thigh_follow.yaml), moves awaited: the
+  // heel's path runs along the uncut layer, where a border is not conformed; what the next
+  // move frees is cut by later sweeps, not by the one that passed. 86 % opened and a 10.6 mm
+  // gap (85 % and 4.1 mm before the conformed borders): under one operation tet.
+  const Scene small = load_scene(path);
+  Simulation tight(small, offline);
+  const StrokeResult t = play_stroke(tight, poses, Vec3::UnitZ(), 0.03, 0.11);
+  report("thigh 10 cm stroke, follow, 2.5 cm ball", tight, t);
+  EXPECT_GE(t.opened, 0.8 * t.swept);
+  EXPECT_LE(t.max_gap, 0.011);
+  EXPECT_LT(t.error_vs_full, 1e-9);
 }
 
 // The same stroke with every pose held for three steps (a lockstep bag replay through
