@@ -118,9 +118,9 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   // Item 3: the walls, carried by the deformation the blade cut through, lie on its path
   // (before the blade was carried to rest coordinates they lay 25 mm off it, where the rest
   // mesh was). Opened: a floor only; the swept area is not all open yet (README).
-  // Conformed borders (stop 23): faces 1.006 x tolerance past the sweep (0.41 x before, when
+  // Conformed borders (stop 27): faces 1.01 x tolerance past the sweep (0.41 x before, when
   // the walls covered 60 % of the sweep instead of 85 % and left a 13 mm hole): issue 9's
-  // item 2 is missed here by 0.6 %, asserted with that margin.
+  // item 2 is missed here by 1 %, asserted with a 5 % margin (README, limitations).
   EXPECT_LE(f.faces_over_tolerance, 1.05) << line.str();
   EXPECT_GE(f.wall_alignment, 0.95) << line.str();
   EXPECT_GE(f.covered_area, 0.5 * f.swept_area) << line.str();

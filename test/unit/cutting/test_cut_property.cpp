@@ -310,11 +310,11 @@ TEST(CutProperty, QualityAfter100Cuts) {
   // 1.49 before nodes on the stroke were tested against each triangle's plane). Bisection only
   // bounds SIZE (t in [0.1, 0.9], guard 1 %), not shape, so angles can fall this far; the
   // thresholds catch regressions.
-  // With conformed borders (stop 23): thigh 0.59 deg / 0.0033, box 0.73 / 0.0024, liver
-  // 0.71 / 0.0031, and 36 % more tets after the 100 sweeps (the tets a border runs through are
-  // cut twice): the price of opening up to the blade.
+  // With conformed borders (stop 27): thigh 0.61 deg / 0.0039, box 0.91 / 0.0031, liver
+  // 0.52 / 0.0027, and 30-50 % more tets after the 100 sweeps (the tets a border runs through
+  // are cut twice): the price of opening up to the blade.
   report_quality_after_100_cuts(thigh_specimen(), 99u, 0.2, 0.0015);
-  report_quality_after_100_cuts(box_specimen(), 99u, 0.3, 0.0015);
+  report_quality_after_100_cuts(box_specimen(), 99u, 0.6, 0.0029);
   report_quality_after_100_cuts(liver_specimen(), 99u, 0.35, 0.0012);
 }
 
