@@ -200,6 +200,14 @@ void measure_matrix(const std::string& mesh_name) {
         // Conformed borders (stop 27): at most 1.7 measured (thigh straight vertical).
         EXPECT_LE(fig.f.faces_over_tolerance, 2.0) << fig.line;
         EXPECT_GE(fig.f.wall_alignment, 0.7) << fig.line;
+        // The conformed borders (docs/DESIGN.md section 8, "Borders"): a straight vertical
+        // stroke opens up to the blade on every mesh, slow or fast - issue 9 item 1's 90 %, and
+        // no hole (the thigh's 3 mm stroke left a 9.4 mm one along the tip's path without them;
+        // measured 107-143 % opened, 100 % covered).
+        if (!curved && tilt == 0) {
+          EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
+          EXPECT_GE(fig.f.covered_area, 0.99 * fig.f.swept_area) << fig.line;
+        }
       }
 }
 
