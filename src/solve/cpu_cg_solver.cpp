@@ -64,19 +64,13 @@ constexpr double kShift = 1e-9;
 // rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
 // the same tets or their neighbours: 22 of the organ stroke's 31 cuts fall inside; two rings
 // took hardly more and doubled the frame's cost). Its dense Schur complement costs |B|^3/3 per
-// cut and 3 |B|^2 doubles (L_BB, W, the factor of S'): a frame grown past half the block, or
-// past a quarter of it once over 600 DOFs, refactors instead (900 DOFs: 20 MB and ~10 ms, more
-// than the thigh's whole refactorization; a soak-like random walk on the thigh reached it), and
-// never past 1200 DOFs (~35 MB, ~20 ms). The quarter lets large operation parts keep their
-// frame: with the conformed cut borders a cut changes more rows, and at 206k tets (6.4k rows, a
-// refactorization 60-140 ms) a 600-DOF cap sent most cuts to a full refactorization (cutting
-// step median 30 -> 74 ms; 37 ms with 1200). A change of E changes every row: no frame.
+// cut and 3 |B|^2 doubles (L_BB, W, the factor of S'): a frame grown past kMaxFrame DOFs, or
+// past half the block, refactors instead (900 DOFs: 20 MB and ~10 ms, more than the thigh's
+// whole refactorization; a soak-like random walk on the thigh reached it). A change of E
+// changes every row: no frame.
 constexpr int kFrameRings = 1;
-constexpr int kMaxFrame = 1200;
-int max_frame(Eigen::Index rows) {
-  const int n = static_cast<int>(rows);
-  return std::min({kMaxFrame, n / 2, std::max(600, n / 4)});
-}
+constexpr int kMaxFrame = 600;
+int max_frame(Eigen::Index rows) { return std::min<int>(kMaxFrame, static_cast<int>(rows / 2)); }
 
 std::string format_residual(double r) {
   char buf[32];
