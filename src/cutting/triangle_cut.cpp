@@ -107,6 +107,30 @@ double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<S
   return smallest;
 }
 
+// The crossings of `crossing` on tet `nodes`' edges, ordered by edge (the order
+// split_along_triangle bisects them in).
+std::vector<Split> splits_of(const Tet& nodes,
+                             const std::map<std::pair<int, int>, double>& crossing) {
+  std::vector<Split> splits;
+  for (const auto& e : kTetEdges) {
+    const int u = std::min(nodes[e[0]], nodes[e[1]]), v = std::max(nodes[e[0]], nodes[e[1]]);
+    auto it = crossing.find({u, v});
+    if (it != crossing.end()) splits.push_back({u, v, it->second});
+  }
+  std::sort(splits.begin(), splits.end(), [](const Split& x, const Split& y) {
+    return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
+  });
+  return splits;
+}
+
+// The volume guard: would bisecting `splits` leave a piece of tet t under min_volume_fraction
+// of the tet it descends from?
+bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vector<Split>& splits,
+              const CutOptions& options) {
+  return !(smallest_piece(mesh, mesh.tets[t], splits) >=
+           options.min_volume_fraction * state.origin_volume[t]);
+}
+
 double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const auto angles = dihedral_angles_deg(a, b, c, d);
   return *std::min_element(angles.begin(), angles.end());
@@ -300,19 +324,8 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
     if (resnap) continue;
     bool snapped = false;
     for (int t : candidates) {
-      std::vector<Split> splits;
-      const Tet& tet = mesh.tets[t];
-      for (const auto& e : kTetEdges) {
-        const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
-        auto it = crossing.find({u, v});
-        if (it != crossing.end()) splits.push_back({u, v, it->second});
-      }
-      if (splits.empty()) continue;
-      std::sort(splits.begin(), splits.end(), [](const Split& x, const Split& y) {
-        return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
-      });
-      if (smallest_piece(mesh, tet, splits) >= options.min_volume_fraction * state.origin_volume[t])
-        continue;
+      const std::vector<Split> splits = splits_of(mesh.tets[t], crossing);
+      if (splits.empty() || !too_thin(mesh, state, t, splits, options)) continue;
       // Too small a piece: snap the end nearest the plane among this tet's crossing edges.
       int nearest = -1;
       double best = 2.0;
@@ -440,19 +453,8 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   for (bool dropped = true; dropped && !crossing.empty();) {
     dropped = false;
     for (int t : candidates) {
-      std::vector<Split> splits;
-      const Tet& tet = mesh.tets[t];
-      for (const auto& e : kTetEdges) {
-        const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
-        auto it = crossing.find({u, v});
-        if (it != crossing.end()) splits.push_back({u, v, it->second});
-      }
-      if (splits.empty()) continue;
-      std::sort(splits.begin(), splits.end(), [](const Split& x, const Split& y) {
-        return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
-      });
-      if (smallest_piece(mesh, tet, splits) >= options.min_volume_fraction * state.origin_volume[t])
-        continue;
+      const std::vector<Split> splits = splits_of(mesh.tets[t], crossing);
+      if (splits.empty() || !too_thin(mesh, state, t, splits, options)) continue;
       const Split* worst = &splits.front();
       for (const Split& x : splits)
         if (std::min(x.t, 1 - x.t) < std::min(worst->t, 1 - worst->t)) worst = &x;
