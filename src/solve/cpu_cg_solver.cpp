@@ -63,14 +63,23 @@ constexpr double kShift = 1e-9;
 // The frame a factorization after a cut keeps for the next cuts (framed_cholesky.hpp): the
 // rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
 // the same tets or their neighbours: 22 of the organ stroke's 31 cuts fall inside; two rings
-// took hardly more and doubled the frame's cost). Its dense Schur complement costs |B|^3/3 per
-// cut and 3 |B|^2 doubles (L_BB, W, the factor of S'): a frame grown past kMaxFrame DOFs, or
-// past half the block, refactors instead (900 DOFs: 20 MB and ~10 ms, more than the thigh's
-// whole refactorization; a soak-like random walk on the thigh reached it). A change of E
+// took hardly more and doubled the frame's cost). Its dense Schur complement costs |B|^3/3
+// flops per cut and 3 |B|^2 doubles (L_BB, W, the factor of S'). A frame is kept while that is
+// no more than a refactorization costs (CHOLMOD's flop count of the last one), never past half
+// the block, at least up to kMinFrame DOFs (~72 MFlop, a few ms) and never past kMaxFrame
+// (~35 MB, ~20 ms). The thigh refactors cheaply and keeps the 600-DOF cap (a soak-like random
+// walk on it reached 900 DOFs: 20 MB, ~10 ms, more than its whole refactorization; a flat
+// 1200-DOF cap grew the thigh soak's RSS by 70 MB); at 206k tets a refactorization costs
+// 60-140 ms, and with the conformed cut borders a cut changes more rows: a 600-DOF cap sent
+// most cuts there to a full refactorization (cutting step median 30 -> 74 ms). A change of E
 // changes every row: no frame.
 constexpr int kFrameRings = 1;
-constexpr int kMaxFrame = 600;
-int max_frame(Eigen::Index rows) { return std::min<int>(kMaxFrame, static_cast<int>(rows / 2)); }
+constexpr int kMinFrame = 600;
+constexpr int kMaxFrame = 1200;
+int max_frame(Eigen::Index rows, double refactor_flops) {
+  const int worth = static_cast<int>(std::cbrt(3 * std::max(refactor_flops, 0.0)));
+  return std::min({static_cast<int>(rows / 2), kMaxFrame, std::max(kMinFrame, worth)});
+}
 
 std::string format_residual(double r) {
   char buf[32];
@@ -348,11 +357,13 @@ class CpuCgSolver final : public LinearSolver {
       changed_since_factor_.reset();
     if (same_rows && active_ == "cholesky" &&
         chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr)) {
-      if (chol_->frame_size() <= max_frame(block.rows())) {
+      if (chol_->frame_size() <= max_frame(block.rows(), chol_->factor_flops())) {
         ++frame_updates_;
         return;
       }
     }
+    // The last factorization's cost stands for this one's (the block changed by one cut).
+    const double refactor_flops = chol_ ? chol_->factor_flops() : 0;
     std::vector<int> frame;
     int dense = interface;
     if (!kept_.empty())
@@ -363,7 +374,7 @@ class CpuCgSolver final : public LinearSolver {
                       : FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
     else if (expected && !expected->empty())  // a fresh factor: frame where a cut is expected
       frame = FramedCholesky::frame_around(block, *expected, dense, kFrameRings);
-    if (static_cast<int>(frame.size()) > max_frame(block.rows())) frame.clear();
+    if (static_cast<int>(frame.size()) > max_frame(block.rows(), refactor_flops)) frame.clear();
     chol_.reset();
     active_ = "jacobi";
     try {

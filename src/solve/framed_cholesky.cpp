@@ -150,6 +150,7 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
   m.common.supernodal = CHOLMOD_SUPERNODAL;
   m.factor = cholmod_analyze_p(&view, m.perm.data(), nullptr, 0, &m.common);
   if (!m.factor) throw std::runtime_error("framed Cholesky (CHOLMOD): the analysis failed");
+  factor_flops_ = m.common.fl;
   {
     const auto blas = blas_guard();
     cholmod_factorize(&view, m.factor, &m.common);

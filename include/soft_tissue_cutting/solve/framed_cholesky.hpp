@@ -48,6 +48,9 @@ class FramedCholesky final : public CholeskySolve {
   int rows() const override { return rows_; }
   int frame_size() const { return static_cast<int>(frame_.size()); }
   int updates() const { return updates_; }
+  // Floating-point operations of the sparse factorization this object made (CHOLMOD's count
+  // from the analysis): what refactoring a matrix like it costs.
+  double factor_flops() const { return factor_flops_; }
 
   // The rows where `a` differs from `previous` (same leading rows; rows beyond previous.rows()
   // count as changed), grown by `rings` rings of neighbours in `a`'s graph: the frame to factor
@@ -65,6 +68,7 @@ class FramedCholesky final : public CholeskySolve {
   std::vector<int> frame_;  // frame DOFs in their elimination order, new DOFs last
   int rows_ = 0;
   int updates_ = 0;
+  double factor_flops_ = 0;
 };
 
 }  // namespace stc

@@ -150,6 +150,27 @@ TEST(FramedCholesky, FrameAroundChangesIsTheChangedRowsAndTheirNeighbours) {
             static_cast<size_t>(f.a.innerVector(0).nonZeros()));
 }
 
+// What a refactorization costs (the CPU solver keeps a frame while refactoring it costs less,
+// cpu_cg_solver.cpp): CHOLMOD's count, n^3/3 for a dense matrix, O(n) for a tridiagonal one.
+TEST(FramedCholesky, CountsTheFlopsOfItsFactorization) {
+  constexpr int n = 120;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Constant(n, n, 0.5);
+  dense.diagonal().array() += n;
+  const SparseMatrix a = dense.sparseView();
+  const double cubic = FramedCholesky(a, {}).factor_flops();
+  EXPECT_NEAR(cubic / (n * n * n / 3.0), 1.0, 0.1) << cubic;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.emplace_back(i, i, 4.0);
+    if (i > 0) entries.emplace_back(i, i - 1, -1.0), entries.emplace_back(i - 1, i, -1.0);
+  }
+  SparseMatrix tridiagonal(n, n);
+  tridiagonal.setFromTriplets(entries.begin(), entries.end());
+  const double linear = FramedCholesky(tridiagonal, {}).factor_flops();
+  EXPECT_GT(linear, 0);
+  EXPECT_LT(linear, 10.0 * n) << linear;
+}
+
 TEST(FramedCholesky, TakesChangesInsideTheFrameAndNewDofsCoupledToIt) {
   const Framed f = thigh_matrix();
   FramedCholesky factor(f.a, f.frame);
