@@ -32,6 +32,9 @@ struct CutState {
   // that only appear when this sweep splits the tets around them, and that this sweep's own
   // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
+  // The same stroke's bands as a face's corners are checked against: less of the margin ahead
+  // of the motion (CutOptions::corner_margin_fraction), same cap.
+  std::vector<std::array<Vec3, 3>> last_corners;
   // Per node (grown on demand): on the current stroke's cut surface - created on it by a
   // split, taken onto it by the snap rule, or a copy made by opening it. A triangle of the
   // stroke treats these as "on" where they lie within its snap distance of its plane, and any

@@ -45,11 +45,14 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
 // borders: where the cut surface ends inside the tissue; the faces on the cut are split there
 // (split_along_border) so that the cut opens up to them.
 // skin_slack: as mark_faces_on_triangle's (triangle_cut.hpp).
+// corner_surface: the surface a marked face's corners must lie on (default: the triangles and
+// also_mark_in).
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options = {},
                         const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
                         const std::vector<CutBorder>& borders = {},
-                        double skin_slack = kSkinCornerSlack);
+                        double skin_slack = kSkinCornerSlack,
+                        const std::vector<std::array<Vec3, 3>>* corner_surface = nullptr);
 
 }  // namespace stc

@@ -52,6 +52,10 @@ struct CutOptions {
   // the margin ahead lets the opening follow the blade to within about an element.
   double front_margin = -1;
   double front_margin_fraction = 0.25;
+  // How much of that margin ahead of the motion a face the band opens may reach: its corners
+  // must lie on the band cut short there (so a stroke's opening ends at most this much of the
+  // margin past where the blade stopped; the tissue ahead is split by the whole margin).
+  double corner_margin_fraction = 0.75;
 };
 
 struct CutResult {

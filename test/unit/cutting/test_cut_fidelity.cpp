@@ -197,8 +197,10 @@ void measure_matrix(const std::string& mesh_name) {
         EXPECT_GT(fig.f.swept_area, 1e-4) << fig.line;  // the stroke is in the tissue
         EXPECT_GE(fig.f.covered_area, 0.25 * fig.f.swept_area) << fig.line;
         EXPECT_GE(fig.f.opening(), 0.1) << fig.line;
-        // Conformed borders (stop 27): at most 1.7 measured (thigh straight vertical).
-        EXPECT_LE(fig.f.faces_over_tolerance, 2.0) << fig.line;
+        // Conformed borders (stop 27): at most 1.7 measured (thigh straight vertical, the
+        // faces past the stroke's end); faces reaching 3/4 of the front margin (stop 28): 1.38
+        // (the fine liver2's curved vertical 3 mm stroke).
+        EXPECT_LE(fig.f.faces_over_tolerance, 1.6) << fig.line;
         EXPECT_GE(fig.f.wall_alignment, 0.7) << fig.line;
         // The conformed borders (docs/DESIGN.md section 8, "Borders"): a straight vertical
         // stroke opens up to the blade on every mesh, slow or fast - issue 9 item 1's 90 %, and

@@ -400,8 +400,10 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   report("thigh 10 cm stroke, all (no moves)", reference, b);
   // Against the area swept inside the tissue as it hangs: issue 16 asks 90 %. With `all` the
   // conformed borders (docs/DESIGN.md section 8, "Borders") open 109 % of this stroke, with
-  // moves awaited 110 %.
-  EXPECT_GE(r.opened, 0.9 * b.opened);
+  // moves awaited 110 % (stop 27); with faces reaching 3/4 of the front margin past the blade
+  // (stop 28) 97.5 % against `all`'s 110 %: the moves end and restart strokes, and each end
+  // now opens less past the blade.
+  EXPECT_GE(r.opened, 0.85 * b.opened);
   EXPECT_GE(r.opened, 0.9 * r.swept);
   EXPECT_LE(r.max_gap, b.max_gap + 0.003);  // no gap at the moves beyond the cutter's own
   EXPECT_LT(r.error_vs_full, 1e-9);
