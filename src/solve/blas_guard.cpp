@@ -24,22 +24,33 @@ BlasInfo detect() {
   if (!info.serialized && !std::getenv("OPENBLAS_NUM_THREADS") && !std::getenv("OMP_NUM_THREADS"))
     if (auto set = reinterpret_cast<ThreadsFn>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
       set(1);
-  // CHOLMOD 3 (Debian 12) opens OpenMP regions of a fixed 4 threads (num_threads(4), which
-  // OMP_NUM_THREADS cannot lower) in every supernodal factorization, to clear work arrays: on
-  // 2 cores, waking and parking those threads cost more than the work (the thigh's cutting
-  // step 13.0 -> 6.4 ms, the organ's 44.5 -> 34.3 ms with them off). Inactive parallel
-  // regions run on the calling thread alone; the user may still choose (OMP_THREAD_LIMIT,
-  // OMP_MAX_ACTIVE_LEVELS).
-  using LevelsFn = void (*)(int);
-  if (!std::getenv("OMP_THREAD_LIMIT") && !std::getenv("OMP_MAX_ACTIVE_LEVELS"))
-    if (auto set = reinterpret_cast<LevelsFn>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels")))
-      set(0);
   return info;
 }
 
 BlasInfo& detected() {
   static BlasInfo info = detect();
   return info;
+}
+
+// CHOLMOD 3 (Debian 12) opens OpenMP regions of a fixed 4 threads (num_threads(4), which
+// OMP_NUM_THREADS cannot lower) in every supernodal factorization, to clear work arrays: on
+// 2 cores, waking and parking those threads cost more than the work (the thigh's cutting
+// step 13.0 -> 6.4 ms, the organ's 44.5 -> 34.3 ms with them off). Inactive parallel regions
+// run on the calling thread alone. libgomp keeps that setting per thread (a thread it did not
+// start begins from the defaults), so every thread that calls CHOLMOD sets it once: a region
+// move's worker did not, and its condensation took twice as long as on the loop's thread
+// (organ liver: 0.55 -> 1.0 s per move). The user may still choose (OMP_THREAD_LIMIT,
+// OMP_MAX_ACTIVE_LEVELS).
+void settle_openmp_on_this_thread() {
+  thread_local bool settled = false;
+  if (settled) return;
+  settled = true;
+  using LevelsFn = void (*)(int);
+  static const LevelsFn set =
+      std::getenv("OMP_THREAD_LIMIT") || std::getenv("OMP_MAX_ACTIVE_LEVELS")
+          ? nullptr
+          : reinterpret_cast<LevelsFn>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  if (set) set(0);
 }
 
 std::atomic<int> forced{-1};  // -1: as detected, 0: never, 1: always
@@ -51,9 +62,13 @@ std::mutex& blas_mutex() {
 
 }  // namespace
 
-const BlasInfo& blas_info() { return detected(); }
+const BlasInfo& blas_info() {
+  settle_openmp_on_this_thread();
+  return detected();
+}
 
 std::unique_lock<std::mutex> blas_guard() {
+  settle_openmp_on_this_thread();
   const int f = forced.load();
   const bool serialize = f < 0 ? detected().serialized : f == 1;
   return serialize ? std::unique_lock<std::mutex>(blas_mutex()) : std::unique_lock<std::mutex>();

@@ -9,8 +9,9 @@
 // matrices CG could not solve). `./tissue setup` installs libopenblas0-pthread instead, which
 // locks. Whatever BLAS the loader picked, these guards make it safe: when the process runs
 // OpenBLAS's single-threaded build, every BLAS-using CHOLMOD call takes one process-wide mutex.
-// The first call also keeps the numeric libraries' own threads out of the loop's way (one
-// OpenBLAS thread per call, CHOLMOD's OpenMP regions inline: see blas_guard.cpp).
+// Either call also keeps the numeric libraries' own threads out of the loop's way (one
+// OpenBLAS thread per call, process-wide, at the first; CHOLMOD's OpenMP regions inline, at
+// the first on each thread: see blas_guard.cpp).
 #pragma once
 
 #include <mutex>
