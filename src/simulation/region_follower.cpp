@@ -3,6 +3,7 @@
 #include "collision/tissue_samples.hpp"
 #include "cutting/free_pieces.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
+#include "solve/blas_guard.hpp"
 
 #include <algorithm>
 #include <exception>
@@ -155,6 +156,7 @@ void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vec
       std::launch::async, [&from, ball, keep = std::move(keep_nodes), held = std::move(held_nodes),
                            points = std::move(cut_points), reach = spacing_]() mutable {
         const auto t0 = Clock::now();
+        settle_openmp_on_this_thread();  // CHOLMOD at full speed here too (blas_guard.hpp)
         MovedRegion r;
         r.centre = ball.center;
         // The free pieces: anchored by fixed or held nodes only (any interface is the old

@@ -32,15 +32,17 @@ BlasInfo& detected() {
   return info;
 }
 
+}  // namespace
+
 // CHOLMOD 3 (Debian 12) opens OpenMP regions of a fixed 4 threads (num_threads(4), which
 // OMP_NUM_THREADS cannot lower) in every supernodal factorization, to clear work arrays: on
 // 2 cores, waking and parking those threads cost more than the work (the thigh's cutting
 // step 13.0 -> 6.4 ms, the organ's 44.5 -> 34.3 ms with them off). Inactive parallel regions
 // run on the calling thread alone. libgomp keeps that setting per thread (a thread it did not
-// start begins from the defaults), so every thread that calls CHOLMOD sets it once: a region
-// move's worker did not, and its condensation took twice as long as on the loop's thread
-// (organ liver: 0.55 -> 1.0 s per move). The user may still choose (OMP_THREAD_LIMIT,
-// OMP_MAX_ACTIVE_LEVELS).
+// start begins from the defaults, one active level): the thread that calls CHOLMOD first sets
+// it, and a region move's worker sets it itself (region_follower.cpp; without it the organ
+// liver's condensation took 1.0 s instead of 0.55 s). The user may still choose
+// (OMP_THREAD_LIMIT, OMP_MAX_ACTIVE_LEVELS).
 void settle_openmp_on_this_thread() {
   thread_local bool settled = false;
   if (settled) return;
@@ -53,6 +55,8 @@ void settle_openmp_on_this_thread() {
   if (set) set(0);
 }
 
+namespace {
+
 std::atomic<int> forced{-1};  // -1: as detected, 0: never, 1: always
 
 std::mutex& blas_mutex() {
@@ -63,12 +67,12 @@ std::mutex& blas_mutex() {
 }  // namespace
 
 const BlasInfo& blas_info() {
-  settle_openmp_on_this_thread();
+  static const bool first_caller_settled = (settle_openmp_on_this_thread(), true);
+  (void)first_caller_settled;
   return detected();
 }
 
 std::unique_lock<std::mutex> blas_guard() {
-  settle_openmp_on_this_thread();
   const int f = forced.load();
   const bool serialize = f < 0 ? detected().serialized : f == 1;
   return serialize ? std::unique_lock<std::mutex>(blas_mutex()) : std::unique_lock<std::mutex>();

@@ -9,9 +9,9 @@
 // matrices CG could not solve). `./tissue setup` installs libopenblas0-pthread instead, which
 // locks. Whatever BLAS the loader picked, these guards make it safe: when the process runs
 // OpenBLAS's single-threaded build, every BLAS-using CHOLMOD call takes one process-wide mutex.
-// Either call also keeps the numeric libraries' own threads out of the loop's way (one
-// OpenBLAS thread per call, process-wide, at the first; CHOLMOD's OpenMP regions inline, at
-// the first on each thread: see blas_guard.cpp).
+// The first call also keeps the numeric libraries' own threads out of the loop's way (one
+// OpenBLAS thread per call; CHOLMOD's OpenMP regions inline on the calling thread: see
+// blas_guard.cpp).
 #pragma once
 
 #include <mutex>
@@ -29,6 +29,13 @@ const BlasInfo& blas_info();
 // Held around each BLAS-using CHOLMOD call: owns the process-wide mutex when the BLAS is not
 // thread-safe, nothing otherwise.
 std::unique_lock<std::mutex> blas_guard();
+
+// CHOLMOD's OpenMP regions inline on the calling thread too (libgomp keeps the setting per
+// thread): a region move's worker calls it before it condenses. Once per thread; cheap after.
+// The loop's and the ROS node's other threads keep what they had: inline there, the thigh
+// soak cut ~35 % more steps per minute and its RSS grew past the soak's 64 MB limit
+// (docs/DESIGN.md section 14).
+void settle_openmp_on_this_thread();
 
 // Tests only: serialize (true), never serialize (false) or detect again (reset).
 void force_blas_serialization(bool serialize);
