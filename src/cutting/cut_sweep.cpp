@@ -13,6 +13,26 @@ namespace {
 // through 6 mm tets - are still opened), bounded so a very long stroke stays cheap.
 constexpr size_t kMaxStrokeTriangles = 1024;
 
+using Triangles = std::vector<std::array<Vec3, 3>>;
+
+// A band's triangles, then the stroke's earlier ones newest first: the order a face's corners
+// are looked for in.
+Triangles nearest_first(const Triangles& band, const Triangles& stroke) {
+  Triangles out = band;
+  out.insert(out.end(), stroke.rbegin(), stroke.rend());
+  return out;
+}
+
+// Appends a band's non-degenerate triangles to the stroke's list (a new stroke: cleared first),
+// keeping the newest kMaxStrokeTriangles.
+void keep_in_stroke(Triangles& stroke, const Triangles& band, bool continues) {
+  if (!continues) stroke.clear();
+  for (const auto& tri : band)
+    if ((tri[1] - tri[0]).cross(tri[2] - tri[0]).norm() > 0) stroke.push_back(tri);
+  if (stroke.size() > kMaxStrokeTriangles)
+    stroke.erase(stroke.begin(), stroke.end() - static_cast<long>(kMaxStrokeTriangles));
+}
+
 long count_marked_face_sides(const TetMesh& mesh) {
   long sides = 0;
   for (std::uint8_t bits : mesh.cut_faces) sides += __builtin_popcount(bits);
@@ -43,8 +63,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   }
   // All splits first, then all marks (triangle_cut.hpp says why).
   // The stroke's surface, nearest first (a face's corners are looked for in this order).
-  std::vector<std::array<Vec3, 3>> surface = triangles;
-  surface.insert(surface.end(), also_mark_in.rbegin(), also_mark_in.rend());
+  const Triangles surface = nearest_first(triangles, also_mark_in);
   for (auto& tri : cut) split_along_triangle(mesh, state, tri, options, result);
   for (const CutBorder& border : borders)
     if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
@@ -176,23 +195,11 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     corners.push_back({a[i], c[i + 1], c[i]});
   }
   if (!continues) state.last_corners.clear();
-  std::vector<std::array<Vec3, 3>> corner_surface = corners;
-  corner_surface.insert(corner_surface.end(), state.last_corners.rbegin(),
-                        state.last_corners.rend());
+  const Triangles corner_surface = nearest_first(corners, state.last_corners);
   CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none,
                                    borders, kSkinCornerSlack, &corner_surface);
-  for (const auto& tri : corners)
-    if ((tri[1] - tri[0]).cross(tri[2] - tri[0]).norm() > 0) state.last_corners.push_back(tri);
-  if (state.last_corners.size() > kMaxStrokeTriangles)
-    state.last_corners.erase(state.last_corners.begin(),
-                             state.last_corners.end() - static_cast<long>(kMaxStrokeTriangles));
-  // The stroke so far (kMaxStrokeTriangles).
-  if (!continues) state.last_sweep.clear();
-  for (const auto& tri : sweep)
-    if ((tri[1] - tri[0]).cross(tri[2] - tri[0]).norm() > 0) state.last_sweep.push_back(tri);
-  if (state.last_sweep.size() > kMaxStrokeTriangles)
-    state.last_sweep.erase(state.last_sweep.begin(),
-                           state.last_sweep.end() - static_cast<long>(kMaxStrokeTriangles));
+  keep_in_stroke(state.last_corners, corners, continues);
+  keep_in_stroke(state.last_sweep, sweep, continues);  // the stroke so far (kMaxStrokeTriangles)
   state.last_sweep_end = {to.front(), to.back()};
   state.last_band = sweep;
   state.last_front.clear();
@@ -214,8 +221,7 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   // No skin slack here: the front is where the blade stopped, and a face reaching past it at
   // the skin would open the tissue ahead of the blade (the end of a curved stroke on a fine
   // liver: open faces 4 x the tolerance past the sweep with it, within tolerance without).
-  const std::vector<std::array<Vec3, 3>> corners(state.last_corners.rbegin(),
-                                                 state.last_corners.rend());
+  const Triangles corners = nearest_first({}, state.last_corners);
   return cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, &corners);
 }
 

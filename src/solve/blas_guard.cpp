@@ -24,6 +24,7 @@ BlasInfo detect() {
   if (!info.serialized && !std::getenv("OPENBLAS_NUM_THREADS") && !std::getenv("OMP_NUM_THREADS"))
     if (auto set = reinterpret_cast<ThreadsFn>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
       set(1);
+  settle_openmp_on_this_thread();  // the first caller's thread (below)
   return info;
 }
 
@@ -66,11 +67,7 @@ std::mutex& blas_mutex() {
 
 }  // namespace
 
-const BlasInfo& blas_info() {
-  static const bool first_caller_settled = (settle_openmp_on_this_thread(), true);
-  (void)first_caller_settled;
-  return detected();
-}
+const BlasInfo& blas_info() { return detected(); }
 
 std::unique_lock<std::mutex> blas_guard() {
   const int f = forced.load();
