@@ -204,13 +204,24 @@ double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEd
                              const BladeEdge& to, double tolerance) {
   const std::array<std::array<Vec3, 3>, 2> now = {
       {{from.tip, from.heel, to.heel}, {from.tip, to.heel, to.tip}}};
+  const double length = (from.heel - from.tip).norm(), reach = tolerance * length;
+  // Only the stroke's triangles within reach of this sweep's box can hold a sample: the
+  // others are skipped unmeasured (a slow stroke has thousands, and this runs every step).
+  Vec3 lo = from.tip.cwiseMin(from.heel).cwiseMin(to.tip).cwiseMin(to.heel);
+  Vec3 hi = from.tip.cwiseMax(from.heel).cwiseMax(to.tip).cwiseMax(to.heel);
+  lo.array() -= reach;
+  hi.array() += reach;
   std::vector<std::array<Vec3, 3>> before;
   for (size_t k = 1; k < stroke.size(); ++k) {
     const BladeEdge &a = stroke[k - 1], &b = stroke[k];
-    before.push_back({a.tip, a.heel, b.heel});
-    before.push_back({a.tip, b.heel, b.tip});
+    for (const std::array<Vec3, 3>& t :
+         {std::array<Vec3, 3>{a.tip, a.heel, b.heel}, std::array<Vec3, 3>{a.tip, b.heel, b.tip}}) {
+      const Vec3 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]),
+                 t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+      if ((t_lo.array() <= hi.array()).all() && (t_hi.array() >= lo.array()).all())
+        before.push_back(t);
+    }
   }
-  const double length = (from.heel - from.tip).norm(), reach = tolerance * length;
   // Interior sample points of each triangle (barycentric grid), weighted by its area.
   constexpr int kGrid = 6;
   double covered = 0, total = 0;

@@ -179,6 +179,16 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
   return true;
 }
 
+// The longest edge from v in its star.
+double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
+  double longest = 0;
+  for (int t : state.node_tets[v])
+    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
+  return longest;
+}
+
+}  // namespace
+
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi) {
   std::vector<int> tets;
@@ -188,7 +198,12 @@ std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, co
   return tets;
 }
 
-}  // namespace
+double NodeScales::longest_edge(const TetMesh& mesh, const CutState& state, int v) {
+  if (longest_.size() < mesh.nodes.size()) longest_.resize(mesh.nodes.size(), -1.0);
+  double& longest = longest_[static_cast<size_t>(v)];
+  if (longest < 0) longest = star_longest_edge(mesh, state, v);
+  return longest;
+}
 
 TriangleClassification::TriangleClassification(const Vec3& a, const Vec3& b, const Vec3& c,
                                                double snap_tolerance)
@@ -207,21 +222,25 @@ bool TriangleClassification::contains(const Vec3& p, double tol) const {
 }
 
 int TriangleClassification::side(const TetMesh& mesh, const CutState& state, int v) {
-  auto it = side_.find(v);
-  if (it != side_.end()) return it->second;
+  if (!side_.empty()) {
+    auto it = side_.find(v);
+    if (it != side_.end()) return it->second;
+  }
   const double d = distance(mesh, v);
   // Only nodes on the plane up to round-off start as "on"; split_along_triangle snaps the
   // end of any crossing edge that the plane meets too near it (CutOptions::snap_tolerance).
-  double longest = 0;
-  for (int t : state.node_tets[v])
-    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
+  const double longest =
+      scales_ ? scales_->longest_edge(mesh, state, v) : star_longest_edge(mesh, state, v);
   // A node already on the stroke's cut surface (cut_state.hpp) is on this triangle too when
   // it lies as near its plane as the snap rule lets a cut lie off the blade. Farther off (a
   // curved or twisting stroke: the stroke's earlier triangles are not coplanar with this one)
   // it is classified like any node, so the edges it ends are still split where they cross.
   const double on = is_on_stroke(state, v) ? snap_tolerance_ : 1e-9;
   const int s = std::abs(d) <= on * longest ? 0 : (d > 0 ? 1 : -1);
-  side_[v] = s;
+  // Kept while the mesh changes (a split must not reclassify the ends of the edges it
+  // shortened); with shared scales nothing changes any more, and the answer is recomputed
+  // from them as cheaply as it would be looked up.
+  if (!scales_) side_[v] = s;
   return s;
 }
 
@@ -490,24 +509,42 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
                             const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
                             CutResult& result, std::set<FaceKey>& new_faces) {
   if (tri.degenerate()) return;
+  mark_faces_on_triangle(mesh, state, tri, cuttable_tets_in(mesh, state, lo, hi), options, surface,
+                         skin_slack, result, new_faces);
+}
+
+void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri,
+                            const std::vector<int>& tets, const CutOptions& options,
+                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
+                            CutResult& result, std::set<FaceKey>& new_faces) {
+  if (tri.degenerate()) return;
   // (c) Faces on the cut: three "on" nodes, centroid inside the triangle, tets on opposite
   // sides. Both tets get the face's bit.
-  for (int t : cuttable_tets_in(mesh, state, lo, hi)) {
+  for (int t : tets) {
+    const Tet& tet = mesh.tets[t];
+    // Any node on the stroke's cut surface may be a corner: a face in the crease between two
+    // non-coplanar triangles of the stroke has corners on each; the checks below keep only
+    // faces that lie along this triangle. Each node's side once per tet (a face needs three
+    // corners on the cut, so a tet with fewer has none).
+    std::array<int, 4> sides{};
+    std::array<bool, 4> on{};
+    int corners_on = 0;
+    for (int k = 0; k < 4; ++k) {
+      sides[k] = tri.side(mesh, state, tet[k]);
+      on[k] = is_on_stroke(state, tet[k]) || sides[k] == 0;
+      corners_on += on[k];
+    }
+    if (corners_on < 3) continue;
     for (int f = 0; f < 4; ++f) {
       if (mesh.is_cut_face(t, f)) continue;
-      const Tet& tet = mesh.tets[t];
+      if (!on[kTetFaces[f][0]] || !on[kTetFaces[f][1]] || !on[kTetFaces[f][2]]) continue;
       const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
-      // Any node on the stroke's cut surface may be a corner: a face in the crease between
-      // two non-coplanar triangles of the stroke has corners on each; the checks below keep
-      // only faces that lie along this triangle.
-      auto on = [&](int v) { return is_on_stroke(state, v) || tri.side(mesh, state, v) == 0; };
-      if (!on(p) || !on(q) || !on(r)) continue;
       const auto [other, other_face] = neighbour_across(mesh, state, t, f);
       if (other < 0) continue;
       // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
       // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
       // it loose, separation keeps it attached, separation.cpp).
-      const int here = tri.side(mesh, state, tet[f]);
+      const int here = sides[f];
       const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
       if (here != 0 && there != 0 && here == there) continue;
       const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];

@@ -19,11 +19,26 @@ namespace stc {
 
 using FaceKey = std::array<int, 3>;  // sorted node triple
 
+// Each node's longest edge (the scale its "on the cut" test is relative to), computed on
+// demand and kept while the mesh does not change: the mark phase classifies the same nodes
+// against every earlier triangle of a stroke (hundreds for a slow blade), and recomputing the
+// star's edges for each was most of a follow-mode cut step.
+class NodeScales {
+ public:
+  double longest_edge(const TetMesh& mesh, const CutState& state, int v);
+
+ private:
+  std::vector<double> longest_;  // < 0: not computed yet
+};
+
 // A cut triangle and the sides its split phase gave the nodes (-1, +1, or 0 = on the cut).
 // Nodes not yet classified are classified on demand with the same snap rule.
 class TriangleClassification {
  public:
   TriangleClassification(const Vec3& a, const Vec3& b, const Vec3& c, double snap_tolerance);
+  // From now on the nodes' scales come from (and go to) `scales`: only once the mesh stops
+  // changing (the mark phase; splits change the stars).
+  void share_scales(NodeScales* scales) { scales_ = scales; }
   bool degenerate() const { return degenerate_; }
   // Is the projection of p onto the plane inside the triangle, with barycentric slack tol?
   bool contains(const Vec3& p, double tol) const;
@@ -39,6 +54,7 @@ class TriangleClassification {
   double double_area_ = 0, snap_tolerance_ = 0;
   bool degenerate_ = false;
   std::unordered_map<int, int> side_;
+  NodeScales* scales_ = nullptr;
 };
 
 // How much farther from the stroke's surface a face's corner on the tissue's boundary may lie
@@ -71,7 +87,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
 
 // Phase 2. Marks interior faces between two cuttable tets with three "on" nodes, the tets'
 // fourth nodes on opposite sides and the centroid inside the triangle, among the tets that
-// overlap [lo, hi]. Newly marked faces are added to `new_faces`.
+// overlap [lo, hi] (or among `tets`). Newly marked faces are added to `new_faces`.
 // surface: every triangle of the stroke so far (this cut's and the earlier ones); a face is
 // marked only if its corners lie on it up to the snap distance, so no face reaching past the
 // blade's path opens (the centroid rule alone would open a face straddling a border).
@@ -81,6 +97,14 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
                             const Vec3& lo, const Vec3& hi, const CutOptions& options,
                             const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
                             CutResult& result, std::set<FaceKey>& new_faces);
+void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& triangle,
+                            const std::vector<int>& tets, const CutOptions& options,
+                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
+                            CutResult& result, std::set<FaceKey>& new_faces);
+
+// The cuttable tets whose boxes overlap [lo, hi].
+std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
+                                  const Vec3& hi);
 
 // The tet across local face `face` of `tet` and that tet's local index of the face, or
 // {-1, -1} on the boundary.
