@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -28,6 +29,13 @@ class TetFaceAdjacency {
   // The members' face-connected pieces: as face_connected_pieces of the members alone (tet
   // indices of `mesh`), in order of their smallest tet.
   std::vector<MeshPiece> pieces(const TetMesh& mesh) const;
+  // The pieces the updates since the last call (or build) may have cut off, found by walking
+  // from the tets whose faces they changed only (docs/DESIGN.md section 10a, "Free pieces"):
+  // every piece reached within `budget` tets, each whole, as pieces() gives them. The walks
+  // that reach more than `budget` tets must all meet (one piece, the rest of the body: it
+  // keeps every node the small pieces do not take); where they do not, nothing is decided
+  // and the answer is empty (std::nullopt): then pieces() decides.
+  std::optional<std::vector<MeshPiece>> pieces_cut_off(const TetMesh& mesh, size_t budget);
 
  private:
   using Key = std::array<int, 3>;  // sorted node triple
@@ -54,6 +62,16 @@ class TetFaceAdjacency {
   std::vector<int> other_;
   std::vector<Key> crowded_;  // faces of more than two users (non-manifold), sorted
   int non_manifold_ = 0;
+  // The members whose faces the updates since the last pieces_cut_off changed, and the other
+  // members on those faces (the walks start there).
+  std::vector<int> changed_since_;
+  // The member tets face-adjacent to t (across a two-user face or a crowded one).
+  template <typename Visit>
+  void for_each_neighbour(int t, const std::vector<std::pair<int, int>>& crowded_pairs,
+                          Visit&& visit) const;
+  std::vector<std::pair<int, int>> crowded_pairs() const;
+  // Tets ascending -> each piece's nodes, ascending.
+  void fill_nodes(const TetMesh& mesh, std::vector<MeshPiece>& pieces) const;
 };
 
 }  // namespace stc
