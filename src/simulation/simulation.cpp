@@ -262,7 +262,16 @@ struct Simulation::Impl {
     auto t0 = Clock::now();
     const BladeEdge a = blade_edge(from, length), b = blade_edge(to, length);
     std::shared_ptr<DeformedToRest> built;
-    if (!frozen) built = current_to_rest();
+    if (!frozen) {
+      // Every point mapped below lies on the two edges or between them: their box, padded
+      // (the locator's own tolerance is barycentric), is all the map needs to cover.
+      Vec3 lo = a.tip.cwiseMin(a.heel).cwiseMin(b.tip).cwiseMin(b.heel);
+      Vec3 hi = a.tip.cwiseMax(a.heel).cwiseMax(b.tip).cwiseMax(b.heel);
+      const double pad = 0.01 * (hi - lo).norm() + 1e-6;
+      built = std::make_shared<DeformedToRest>();
+      built->build(model->mesh(), displacements(), model->partition().operation_tet,
+                   lo.array() - pad, hi.array() + pad);
+    }
     const DeformedToRest& to_rest = frozen ? *frozen : *built;
     std::vector<double> params(kSamples);
     for (int i = 0; i < kSamples; ++i) params[i] = static_cast<double>(i) / (kSamples - 1);
@@ -381,11 +390,29 @@ struct Simulation::Impl {
   // it is.
   void hold_free_pieces() {
     // A fixed region: part 1's pieces, from the faces the cuts kept matched (operation_surface).
-    const std::vector<MeshPiece> pieces = free_pieces(
-        follower ? mesh_faces.pieces(model->mesh()) : boundary.part1_pieces(model->mesh()),
-        model->mesh(), anchored);
+    const std::vector<MeshPiece> pieces =
+        free_pieces(follower ? pieces_a_cut_may_free() : boundary.part1_pieces(model->mesh()),
+                    model->mesh(), anchored);
     for (const MeshPiece& piece : pieces) hold_piece(piece);
     log_pieces_held(pieces);
+  }
+
+  // `follow`: the pieces the cut may have freed, sought from where it changed the mesh
+  // (TetFaceAdjacency::pieces_cut_off, each walk at most an eighth of the mesh); the whole
+  // mesh's pieces where that cannot decide: two walks ran out without meeting (a cut through
+  // the organ), or a piece cut off takes an anchored node (the rest may lose its support).
+  std::vector<MeshPiece> pieces_a_cut_may_free() {
+    const TetMesh& mesh = model->mesh();
+    const size_t budget = std::max<size_t>(2048, mesh.tets.size() / 8);
+    if (auto cut_off = mesh_faces.pieces_cut_off(mesh, budget)) {
+      const bool takes_anchor =
+          std::any_of(cut_off->begin(), cut_off->end(), [&](const MeshPiece& p) {
+            return std::any_of(p.nodes.begin(), p.nodes.end(),
+                               [&](int v) { return anchored[static_cast<size_t>(v)] != 0; });
+          });
+      if (!takes_anchor) return std::move(*cut_off);
+    }
+    return mesh_faces.pieces(mesh);
   }
 
   // Where pieces can come free. A fixed region: only part 1 (every piece of part 2 reaches a
@@ -597,15 +624,17 @@ struct Simulation::Impl {
   // Cuts the waiting sweeps in order while each fits the region; a sweep that would come
   // within one element layer of the interface asks for a move around it and waits (the cut
   // waits at the interface). A sweep no ball of radius R around it can hold is cut as far as
-  // the region reaches, like a fixed region's. Online, cutting stops for this step once it has
-  // taken SimulationOptions::waiting_cut_budget_ms (at least one sweep is cut).
+  // the region reaches, like a fixed region's. Online, cutting stops for this step before a
+  // run that would take it past SimulationOptions::waiting_cut_budget_ms, each run expected
+  // to cost what this step's runs have cost on average (at least one sweep is cut).
   void drain_sweeps(StepStats& s, bool wait) {
     if (!wait && s.region_moved) return;  // online: from the step after the swap (above)
     const double length = scene.scalpel.blade_length;
     const auto t0 = Clock::now();
     int runs_cut = 0;
     while (!pending_sweeps.empty()) {
-      if (!wait && runs_cut > 0 && ms_since(t0) > options.waiting_cut_budget_ms)
+      if (!wait && runs_cut > 0 &&
+          ms_since(t0) * (runs_cut + 1) / runs_cut > options.waiting_cut_budget_ms)
         return;  // the rest from the next step on
       if (follower->moving()) {
         s.reached_interface = true;  // the cut waits at the interface for the move

@@ -39,9 +39,10 @@ struct SimulationOptions {
   // (offline: deterministic, every run moves at the same steps). Off (online), the old model
   // runs until the worker has finished and the loop never blocks.
   bool wait_for_region_moves = false;
-  // `follow` region, online: the sweeps that waited for a move are cut at most this long per
-  // step (ms; the rest wait for the next steps), so the step that swaps a moved region in
-  // does not cut the whole backlog at once (docs/DESIGN.md section 10a, "Swap"). Offline
+  // `follow` region, online: the sweeps that waited for a move are cut for about this long
+  // per step (ms; another run of them only while the step's runs so far, at their average
+  // cost, leave room for it; the rest wait for the next steps), so a step after a swap does
+  // not cut the whole backlog at once (docs/DESIGN.md section 10a, "Swap"). Offline
   // (wait_for_region_moves) every waiting sweep is cut at once.
   double waiting_cut_budget_ms = 8.0;
 };
