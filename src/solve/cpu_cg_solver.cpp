@@ -61,9 +61,15 @@ namespace {
 constexpr double kShift = 1e-9;
 
 // The frame a factorization after a cut keeps for the next cuts (framed_cholesky.hpp): the
-// rows the cut changed and one ring of their neighbours (the next sweep, ~1 mm further, splits
-// the same tets or their neighbours: 22 of the organ stroke's 31 cuts fall inside; two rings
-// took hardly more and doubled the frame's cost). Its dense Schur complement costs |B|^3/3
+// rows the cut changed and two rings of their neighbours where those stay within
+// kWiderFrameShare of the cap below, else one ring (the next sweep splits the same tets or
+// their neighbours, and a slow blade's often those of the next ring too: the organ liver, a
+// blade moving 0.05 mm per step and each sweep cut at its step, 172 cuts: outside a one-ring
+// frame 85 times, outside a two-ring one 44 times, the cutting steps' solve median 12.1 ->
+// 5.7 ms with two rings up to the whole cap, 7.3 ms up to 0.6 of it). Wider frames cost every
+// cut more: on the bench's 1 mm strokes, where 22 of the organ's 31 cuts fell inside one ring
+// already, two rings up to the whole cap took the solve median 3.6 -> 5.8 ms and the maximum
+// 27 -> 37 ms; up to 0.6 of it, 3.6 ms and 27 ms. Its dense Schur complement costs |B|^3/3
 // flops per cut and 3 |B|^2 doubles (L_BB, W, the factor of S'). A frame is kept while that is
 // no more than a refactorization costs (CHOLMOD's flop count of the last one), never past half
 // the block, at least up to kMinFrame DOFs (~72 MFlop, a few ms) and never past kMaxFrame
@@ -73,7 +79,8 @@ constexpr double kShift = 1e-9;
 // 60-140 ms, and with the conformed cut borders a cut changes more rows: a 600-DOF cap sent
 // most cuts there to a full refactorization (cutting step median 30 -> 74 ms). A change of E
 // changes every row: no frame.
-constexpr int kFrameRings = 1;
+constexpr int kFrameRings = 2;
+constexpr double kWiderFrameShare = 0.6;
 constexpr int kMinFrame = 600;
 constexpr int kMaxFrame = 1200;
 int max_frame(Eigen::Index rows, double refactor_flops) {
@@ -369,12 +376,17 @@ class CpuCgSolver final : public LinearSolver {
     if (!kept_.empty())
       dense =
           static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) - kept_.begin());
-    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows())
-      frame = changed ? FramedCholesky::frame_around(block, *changed, dense, kFrameRings)
-                      : FramedCholesky::frame_around_changes(previous, block, dense, kFrameRings);
-    else if (expected && !expected->empty())  // a fresh factor: frame where a cut is expected
-      frame = FramedCholesky::frame_around(block, *expected, dense, kFrameRings);
-    if (static_cast<int>(frame.size()) > max_frame(block.rows(), refactor_flops)) frame.clear();
+    const int cap = max_frame(block.rows(), refactor_flops);
+    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows()) {
+      for (int rings = kFrameRings; rings >= 1; --rings) {  // fewer rings where more pass the cap
+        frame = changed ? FramedCholesky::frame_around(block, *changed, dense, rings)
+                        : FramedCholesky::frame_around_changes(previous, block, dense, rings);
+        if (frame.size() <= (rings > 1 ? kWiderFrameShare : 1.0) * cap) break;
+      }
+    } else if (expected && !expected->empty()) {  // a fresh factor: frame where a cut is expected
+      frame = FramedCholesky::frame_around(block, *expected, dense, 1);
+    }
+    if (static_cast<int>(frame.size()) > cap) frame.clear();
     chol_.reset();
     active_ = "jacobi";
     try {
