@@ -526,12 +526,17 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
     // non-coplanar triangles of the stroke has corners on each; the checks below keep only
     // faces that lie along this triangle. Each node's side once per tet (a face needs three
     // corners on the cut, so a tet with fewer has none).
-    std::array<int, 4> sides{};
+    // Sides on demand (a node on the stroke is "on" whatever its side).
+    constexpr int kUnknown = 2;
+    std::array<int, 4> sides = {kUnknown, kUnknown, kUnknown, kUnknown};
+    auto side_of = [&](int k) {
+      if (sides[k] == kUnknown) sides[k] = tri.side(mesh, state, tet[k]);
+      return sides[k];
+    };
     std::array<bool, 4> on{};
     int corners_on = 0;
     for (int k = 0; k < 4; ++k) {
-      sides[k] = tri.side(mesh, state, tet[k]);
-      on[k] = is_on_stroke(state, tet[k]) || sides[k] == 0;
+      on[k] = is_on_stroke(state, tet[k]) || side_of(k) == 0;
       corners_on += on[k];
     }
     if (corners_on < 3) continue;
@@ -539,14 +544,8 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
       if (mesh.is_cut_face(t, f)) continue;
       if (!on[kTetFaces[f][0]] || !on[kTetFaces[f][1]] || !on[kTetFaces[f][2]]) continue;
       const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
-      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
-      if (other < 0) continue;
-      // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
-      // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
-      // it loose, separation keeps it attached, separation.cpp).
-      const int here = sides[f];
-      const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
-      if (here != 0 && there != 0 && here == there) continue;
+      // The geometric tests first: most faces of the stroke's surface lie along another of
+      // its triangles, and these reject them before the neighbour is looked up.
       const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];
       const Vec3 centroid = (xp + xq + xr) / 3.0;
       if (!tri.contains(centroid, options.inside_tolerance)) continue;
@@ -558,6 +557,14 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
           kOnCutSlack * longest)
         continue;
       if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) continue;
+      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+      if (other < 0) continue;
+      // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
+      // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
+      // it loose, separation keeps it attached, separation.cpp).
+      const int here = side_of(f);
+      const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
+      if (here != 0 && there != 0 && here == there) continue;
       // Its corners too, on the stroke's surface up to the same slack: the centroid alone
       // would open a face that reaches well past a border of the sweep.
       const double slack = kOnCutSlack * longest;
