@@ -8,22 +8,22 @@ namespace stc {
 
 void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
                            const std::vector<std::uint8_t>& include) {
+  // Only the included tets are kept (the operation part: a few thousand of the organ's 70k).
+  std::vector<int> tets;
+  for (size_t t = 0; t < mesh.tets.size(); ++t)
+    if (include.empty() || include[t]) tets.push_back(static_cast<int>(t));
   const Vec3 everywhere = Vec3::Constant(std::numeric_limits<double>::infinity());
-  build(mesh, displacement, include, -everywhere, everywhere);
+  build(mesh, displacement, tets, -everywhere, everywhere);
 }
 
 void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
-                           const std::vector<std::uint8_t>& include, const Vec3& lo,
-                           const Vec3& hi) {
-  // Only the included tets are kept (the operation part: a few thousand of the organ's 70k),
-  // and of those the ones that reach into [lo, hi] as deformed.
+                           const std::vector<int>& tets, const Vec3& lo, const Vec3& hi) {
   mesh_.nodes = mesh.nodes;
   mesh_.tets.clear();
   std::vector<Vec3> x(mesh.nodes.size());
   for (size_t i = 0; i < x.size(); ++i) x[i] = mesh.nodes[i] + displacement[i];
-  for (size_t t = 0; t < mesh.tets.size(); ++t) {
-    if (!include.empty() && !include[t]) continue;
-    const Tet& k = mesh.tets[t];
+  for (int t : tets) {
+    const Tet& k = mesh.tets[static_cast<size_t>(t)];
     const Vec3 t_lo = x[k[0]].cwiseMin(x[k[1]]).cwiseMin(x[k[2]]).cwiseMin(x[k[3]]);
     const Vec3 t_hi = x[k[0]].cwiseMax(x[k[1]]).cwiseMax(x[k[2]]).cwiseMax(x[k[3]]);
     if ((t_lo.array() <= hi.array()).all() && (t_hi.array() >= lo.array()).all())

@@ -269,7 +269,7 @@ struct Simulation::Impl {
       Vec3 hi = a.tip.cwiseMax(a.heel).cwiseMax(b.tip).cwiseMax(b.heel);
       const double pad = 0.01 * (hi - lo).norm() + 1e-6;
       built = std::make_shared<DeformedToRest>();
-      built->build(model->mesh(), displacements(), model->partition().operation_tet,
+      built->build(model->mesh(), displacements(), model->partition().operation_tets,
                    lo.array() - pad, hi.array() + pad);
     }
     const DeformedToRest& to_rest = frozen ? *frozen : *built;

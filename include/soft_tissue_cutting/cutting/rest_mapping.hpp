@@ -26,11 +26,12 @@ class DeformedToRest {
   // requested in, however many steps run between its slices (simulation.hpp, PathCut).
   void build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
              const std::vector<std::uint8_t>& include = {});
-  // The same, keeping only the included tets whose deformed box overlaps [lo, hi]: enough for
-  // points in that box (a cut step's edges: a few hundred tets instead of the operation part's
-  // thousands, rebuilt at every cut).
+  // The same over `tets` (indices into mesh.tets, e.g. the operation part's list), keeping
+  // only those whose deformed box overlaps [lo, hi]: enough for points in that box (a cut
+  // step's edges: a few hundred tets instead of the operation part's thousands, and the
+  // organ's 71k never scanned; rebuilt at every cut).
   void build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
-             const std::vector<std::uint8_t>& include, const Vec3& lo, const Vec3& hi);
+             const std::vector<int>& tets, const Vec3& lo, const Vec3& hi);
   // The rest position of deformed point x, or nothing when x is in no included tet.
   std::optional<Vec3> map(const Vec3& x) const;
   // The edge tip -> heel sampled at parameters s (ascending in [0, 1]) and carried to rest.
