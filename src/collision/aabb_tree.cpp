@@ -14,6 +14,19 @@ void AabbTree::build(const std::vector<Box3>& boxes) {
   order_.resize(boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i) order_[i] = static_cast<int>(i);
   if (!boxes.empty()) build_node(boxes, 0, static_cast<int>(boxes.size()));
+  boxes_ = boxes;
+  leaf_of_.assign(boxes.size(), -1);
+  parent_.assign(nodes_.size(), -1);
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    const Node& node = nodes_[i];
+    if (node.left < 0) {
+      for (int k = node.first; k < node.first + node.count; ++k)
+        leaf_of_[static_cast<size_t>(order_[static_cast<size_t>(k)])] = static_cast<int>(i);
+    } else {
+      parent_[static_cast<size_t>(node.left)] = parent_[static_cast<size_t>(node.right)] =
+          static_cast<int>(i);
+    }
+  }
 }
 
 int AabbTree::build_node(const std::vector<Box3>& boxes, int first, int count) {
@@ -42,6 +55,7 @@ int AabbTree::build_node(const std::vector<Box3>& boxes, int first, int count) {
 }
 
 void AabbTree::refit(const std::vector<Box3>& boxes) {
+  boxes_ = boxes;
   // Children are created after their parent, so a reverse sweep visits children first.
   for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
     Node& node = nodes_[i];
@@ -51,6 +65,30 @@ void AabbTree::refit(const std::vector<Box3>& boxes) {
     } else {
       node.box.extend(nodes_[node.left].box);
       node.box.extend(nodes_[node.right].box);
+    }
+  }
+}
+
+void AabbTree::refit(const std::vector<std::pair<int, Box3>>& changed) {
+  std::vector<int> dirty;
+  for (const auto& [primitive, box] : changed) {
+    boxes_[static_cast<size_t>(primitive)] = box;
+    for (int i = leaf_of_[static_cast<size_t>(primitive)]; i >= 0;
+         i = parent_[static_cast<size_t>(i)])
+      dirty.push_back(i);
+  }
+  std::sort(dirty.begin(), dirty.end());
+  dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
+  // Children first, as in the whole refit.
+  for (auto it = dirty.rbegin(); it != dirty.rend(); ++it) {
+    Node& node = nodes_[static_cast<size_t>(*it)];
+    node.box.setEmpty();
+    if (node.left < 0) {
+      for (int k = node.first; k < node.first + node.count; ++k)
+        node.box.extend(boxes_[static_cast<size_t>(order_[static_cast<size_t>(k)])]);
+    } else {
+      node.box.extend(nodes_[static_cast<size_t>(node.left)].box);
+      node.box.extend(nodes_[static_cast<size_t>(node.right)].box);
     }
   }
 }

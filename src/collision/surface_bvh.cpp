@@ -74,13 +74,49 @@ void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
   } else {
     other_tree_.build(triangle_boxes(other_triangles_));
     other_nodes_ = std::move(other_nodes);
+    other_start_.assign(mesh.nodes.size() + 1, 0);
+    for (const Tri& tri : other_nodes_)
+      for (int v : tri) ++other_start_[static_cast<size_t>(v) + 1];
+    for (size_t v = 0; v < mesh.nodes.size(); ++v) other_start_[v + 1] += other_start_[v];
+    other_of_node_.assign(static_cast<size_t>(other_start_.back()), -1);
+    std::vector<int> fill(other_start_.begin(), other_start_.end() - 1);
+    for (size_t k = 0; k < other_nodes_.size(); ++k)
+      for (int v : other_nodes_[k])
+        other_of_node_[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(k);
   }
 }
 
 void SurfaceBvh::refit(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
+  // The other triangles (a `follow` region's condensed surface: 16.8k of the organ liver's
+  // 18.8k) keep their places from one step to the next but for the ~100-150 on interface
+  // nodes, until the condensed part's displacement is recovered again: only the triangles
+  // whose nodes moved are refitted (a step's refit 0.42 -> ~0.15 ms there).
+  const bool resized = positions_.size() != mesh.nodes.size();
+  std::vector<Vec3> previous;
+  if (!resized) previous.swap(positions_);
   update_positions(mesh, displacement);
   operation_tree_.refit(triangle_boxes(operation_triangles_));
-  other_tree_.refit(triangle_boxes(other_triangles_));
+  std::vector<int> primitives;  // of the other tree, on a node that moved
+  const size_t indexed =
+      std::min(previous.size(), other_start_.empty() ? 0 : other_start_.size() - 1);
+  for (size_t v = 0; v < indexed && !resized; ++v)
+    if (positions_[v] != previous[v])
+      primitives.insert(primitives.end(), other_of_node_.begin() + other_start_[v],
+                        other_of_node_.begin() + other_start_[v + 1]);
+  std::sort(primitives.begin(), primitives.end());
+  primitives.erase(std::unique(primitives.begin(), primitives.end()), primitives.end());
+  std::vector<std::pair<int, Box3>> moved;
+  for (int k : primitives) {
+    const Tri& nodes = other_nodes_[static_cast<size_t>(k)];
+    Box3 box(positions_[static_cast<size_t>(nodes[0])]);
+    box.extend(positions_[static_cast<size_t>(nodes[1])]);
+    box.extend(positions_[static_cast<size_t>(nodes[2])]);
+    moved.emplace_back(k, box);
+  }
+  if (resized || 4 * moved.size() > other_nodes_.size())
+    other_tree_.refit(triangle_boxes(other_triangles_));
+  else if (!moved.empty())
+    other_tree_.refit(moved);
 }
 
 std::vector<int> SurfaceBvh::near_segment(const Vec3& a, const Vec3& b, double margin) const {

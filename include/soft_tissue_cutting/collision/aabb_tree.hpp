@@ -17,6 +17,9 @@ class AabbTree {
   void build(const std::vector<Box3>& primitive_boxes);
   // Same primitives, new boxes (same order as build).
   void refit(const std::vector<Box3>& primitive_boxes);
+  // Same primitives, new boxes for a few of them (primitive index, box): only their leaves and
+  // those leaves' ancestors are refitted; the same tree as refit() with every box.
+  void refit(const std::vector<std::pair<int, Box3>>& changed);
   // Primitives whose box overlaps `box` (appended to out, unordered).
   void overlapping(const Box3& box, std::vector<int>& out) const;
   // Primitives whose box the ray origin + s dir, s >= 0, meets.
@@ -33,6 +36,9 @@ class AabbTree {
   int build_node(const std::vector<Box3>& boxes, int first, int count);
   std::vector<Node> nodes_;
   std::vector<int> order_;
+  std::vector<Box3> boxes_;   // per primitive, as last built or refitted
+  std::vector<int> leaf_of_;  // per primitive: its leaf node
+  std::vector<int> parent_;   // per node, -1 for the root
 };
 
 }  // namespace stc

@@ -47,6 +47,9 @@ class SurfaceBvh {
   // Per tree, its triangles (indices into surface_.triangles) in the tree's primitive order.
   std::vector<int> operation_triangles_, other_triangles_;
   std::vector<Tri> other_nodes_;  // the other triangles' nodes at the last rebuild of their tree
+  // Per node, the other tree's primitives on it (CSR: other_of_node_[other_start_[v] ..
+  // other_start_[v + 1]]), so a refit finds the few that moved from the nodes that did.
+  std::vector<int> other_start_, other_of_node_;
   AabbTree operation_tree_, other_tree_;
 };
 

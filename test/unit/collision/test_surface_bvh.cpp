@@ -114,6 +114,18 @@ TEST(CollisionBvh, OperationAndOtherTreesAnswerLikeOneTree) {
   split.build(scene.mesh, operation, moved);  // the other triangles' tree kept, refitted
   one.build(scene.mesh, {}, moved);
   same_answers("after a second build");
+  // A step's refit: only the nodes near the operation part move (its interface), so the other
+  // tree refits the few triangles on them, their leaves and those leaves' ancestors.
+  int near = 0;
+  for (size_t i = 0; i < moved.size(); ++i)
+    if (std::abs(scene.mesh.nodes[i].x() - 0.03) < 6e-3) {
+      moved[i] += Vec3(3e-3, -2e-3, 1e-3);
+      ++near;
+    }
+  ASSERT_GT(near, 0);
+  split.refit(scene.mesh, moved);
+  one.refit(scene.mesh, moved);
+  same_answers("after a refit that moved a few nodes");
 }
 
 }  // namespace
