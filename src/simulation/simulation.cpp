@@ -343,7 +343,18 @@ struct Simulation::Impl {
       if (n.kind == NewNode::Kind::kDuplicate)
         if (const auto it = held.find(n.a); it != held.end()) held[n.index] = it->second;
     recompute_anchors();
+    const int held_before = free_pieces_held;
     hold_free_pieces();
+    if (free_pieces_held > held_before) {
+      // The held DOFs leave the factor, so its rows change and the next factorization cannot
+      // frame this cut's changes: it frames this cut's nodes instead, where the next cut is.
+      std::vector<int> nodes;
+      for (int t : r.changed_tets)
+        for (int v : model->mesh().tets[static_cast<size_t>(t)]) nodes.push_back(v);
+      std::sort(nodes.begin(), nodes.end());
+      nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+      model->expect_cut_near(std::move(nodes));
+    }
     pass_held_nodes_to_model();
     cut_since_solve = true;
     rebuild_surface_tree();

@@ -113,6 +113,11 @@ class HybridModel {
   // held node by a cut is held too. The solver is set up again (at first use) only when the set
   // changes.
   void set_held_nodes(const std::vector<int>& nodes);
+  // Where the next cut is expected (nodes): a factorization that cannot take its matrix
+  // through the last frame (held nodes changed the rows) frames their rows instead
+  // (LinearSolver::History::expected_rows, docs/DESIGN.md section 6.2). Forgotten at the next
+  // factor refresh.
+  void expect_cut_near(std::vector<int> nodes) { expected_cut_nodes_ = std::move(nodes); }
 
   void set_solver(std::unique_ptr<LinearSolver> solver);
   // The solver, set up (factored) for the current matrix and held nodes.
