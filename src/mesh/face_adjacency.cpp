@@ -28,6 +28,7 @@ void TetFaceAdjacency::build(const TetMesh& mesh, const std::vector<int>& tets) 
   crowded_.clear();
   non_manifold_ = 0;
   update(mesh, tets);
+  tracking_ = false;
   changed_since_.clear();
 }
 
@@ -105,6 +106,7 @@ void TetFaceAdjacency::update(const TetMesh& mesh, const std::vector<int>& chang
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   for (const Key& key : touched) refresh(key);
+  if (!tracking_) return;
   changed_since_.insert(changed_since_.end(), changed.begin(), changed.end());
   for (const Key& key : touched)
     if (const auto it = faces_.find(key); it != faces_.end())
@@ -209,6 +211,7 @@ std::vector<MeshPiece> TetFaceAdjacency::pieces(const TetMesh& mesh) const {
 
 std::optional<std::vector<MeshPiece>> TetFaceAdjacency::pieces_cut_off(const TetMesh& mesh,
                                                                        size_t budget) {
+  if (!tracking_) return std::nullopt;
   std::vector<int> seeds;
   seeds.swap(changed_since_);
   std::sort(seeds.begin(), seeds.end());

@@ -185,6 +185,7 @@ struct Simulation::Impl {
       std::vector<int> all(model->mesh().tets.size());
       std::iota(all.begin(), all.end(), 0);
       mesh_faces.build(model->mesh(), all);
+      mesh_faces.track_cut_off(true);  // pieces_a_cut_may_free
     }
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
     ++surface_version;

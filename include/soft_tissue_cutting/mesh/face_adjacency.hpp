@@ -29,12 +29,18 @@ class TetFaceAdjacency {
   // The members' face-connected pieces: as face_connected_pieces of the members alone (tet
   // indices of `mesh`), in order of their smallest tet.
   std::vector<MeshPiece> pieces(const TetMesh& mesh) const;
-  // The pieces the updates since the last call (or build) may have cut off, found by walking
-  // from the tets whose faces they changed only (docs/DESIGN.md section 10a, "Free pieces"):
-  // every piece reached within `budget` tets, each whole, as pieces() gives them. The walks
-  // that reach more than `budget` tets must all meet (one piece, the rest of the body: it
+  // Whether update() records the tets pieces_cut_off walks from (off by default, and after
+  // build: a user that never asks would keep every changed tet of the session).
+  void track_cut_off(bool on) {
+    tracking_ = on;
+    changed_since_.clear();
+  }
+  // The pieces the updates since the last call (or track_cut_off) may have cut off, found by
+  // walking from the tets whose faces they changed only (docs/DESIGN.md section 10a, "Free
+  // pieces"): every piece reached within `budget` tets, each whole, as pieces() gives them. The
+  // walks that reach more than `budget` tets must all meet (one piece, the rest of the body: it
   // keeps every node the small pieces do not take); where they do not, nothing is decided
-  // and the answer is empty (std::nullopt): then pieces() decides.
+  // and the answer is empty (std::nullopt): then pieces() decides. Not tracking: nullopt.
   std::optional<std::vector<MeshPiece>> pieces_cut_off(const TetMesh& mesh, size_t budget);
 
  private:
@@ -65,6 +71,7 @@ class TetFaceAdjacency {
   // The members whose faces the updates since the last pieces_cut_off changed, and the other
   // members on those faces (the walks start there).
   std::vector<int> changed_since_;
+  bool tracking_ = false;
   // The member tets face-adjacent to t (across a two-user face or a crowded one).
   template <typename Visit>
   void for_each_neighbour(int t, const std::vector<std::pair<int, int>>& crowded_pairs,

@@ -102,6 +102,7 @@ int sweep_and_check(const Scene& scene, unsigned seed, int sweeps) {
   std::vector<int> members = p.operation_tets;
   TetFaceAdjacency adjacency;
   adjacency.build(mesh, members);
+  adjacency.track_cut_off(true);
   expect_same(adjacency, mesh, members, "uncut");
   std::vector<MeshPiece> pieces = adjacency.pieces(mesh);
   int decided = 0;
@@ -178,8 +179,10 @@ TEST(TetFaceAdjacency, FollowsSweepsThatSeverPieces) {
   TetFaceAdjacency adjacency;
   adjacency.build(mesh, members);
   ASSERT_EQ(adjacency.pieces(mesh).size(), 1u);
+  adjacency.track_cut_off(true);
   TetFaceAdjacency twin;  // the same updates, its walks with a budget that takes all
   twin.build(mesh, members);
+  twin.track_cut_off(true);
   // A blade longer than the box, drawn through all of it: x = 0.0213, then y = 0.0137.
   const std::vector<std::array<Vec3, 2>> planes = {
       {Vec3(0.0213, -0.01, -0.01), Vec3(0.0213, 0.04, -0.01)},
@@ -232,6 +235,7 @@ TEST(TetFaceAdjacency, FaceOfThreeTetsJoinsThemUntilOneLeaves) {
   std::vector<int> members = {0, 1, 2};
   TetFaceAdjacency adjacency;
   adjacency.build(mesh, members);
+  adjacency.track_cut_off(true);
   expect_same(adjacency, mesh, members, "three tets on one face");
   ASSERT_EQ(adjacency.pieces(mesh).size(), 1u);
   mesh.tets[2] = {6, 7, 8, 5};  // off the shared face: two tets share it now
@@ -294,6 +298,10 @@ TEST(TetFaceAdjacency, CutOffPiecesAreFoundFromTheChange) {
   for (const size_t budget : {quarter, size_t{10}, members.size()}) {
     TetFaceAdjacency adjacency;
     adjacency.build(uncut, members);
+    adjacency.update(mesh, slab);
+    EXPECT_FALSE(adjacency.pieces_cut_off(mesh, budget).has_value());  // not tracking: undecided
+    adjacency.build(uncut, members);
+    adjacency.track_cut_off(true);
     adjacency.update(mesh, slab);
     const std::vector<MeshPiece> pieces = adjacency.pieces(mesh);
     ASSERT_EQ(pieces.size(), 2u);
