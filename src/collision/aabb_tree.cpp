@@ -9,12 +9,11 @@ namespace {
 constexpr int kLeafSize = 4;
 }
 
-void AabbTree::build(const std::vector<Box3>& boxes) {
+void AabbTree::build(std::vector<Box3> boxes) {
   nodes_.clear();
   order_.resize(boxes.size());
   for (size_t i = 0; i < boxes.size(); ++i) order_[i] = static_cast<int>(i);
   if (!boxes.empty()) build_node(boxes, 0, static_cast<int>(boxes.size()));
-  boxes_ = boxes;
   leaf_of_.assign(boxes.size(), -1);
   parent_.assign(nodes_.size(), -1);
   for (size_t i = 0; i < nodes_.size(); ++i) {
@@ -27,6 +26,7 @@ void AabbTree::build(const std::vector<Box3>& boxes) {
           static_cast<int>(i);
     }
   }
+  boxes_ = std::move(boxes);
 }
 
 int AabbTree::build_node(const std::vector<Box3>& boxes, int first, int count) {
@@ -54,19 +54,9 @@ int AabbTree::build_node(const std::vector<Box3>& boxes, int first, int count) {
   return index;
 }
 
-void AabbTree::refit(const std::vector<Box3>& boxes) {
-  boxes_ = boxes;
-  // Children are created after their parent, so a reverse sweep visits children first.
-  for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
-    Node& node = nodes_[i];
-    node.box.setEmpty();
-    if (node.left < 0) {
-      for (int k = node.first; k < node.first + node.count; ++k) node.box.extend(boxes[order_[k]]);
-    } else {
-      node.box.extend(nodes_[node.left].box);
-      node.box.extend(nodes_[node.right].box);
-    }
-  }
+void AabbTree::refit(std::vector<Box3> boxes) {
+  boxes_ = std::move(boxes);
+  refit_nodes(static_cast<int>(nodes_.size()) - 1, 0);
 }
 
 void AabbTree::refit(const std::vector<std::pair<int, Box3>>& changed) {
@@ -79,9 +69,13 @@ void AabbTree::refit(const std::vector<std::pair<int, Box3>>& changed) {
   }
   std::sort(dirty.begin(), dirty.end());
   dirty.erase(std::unique(dirty.begin(), dirty.end()), dirty.end());
-  // Children first, as in the whole refit.
-  for (auto it = dirty.rbegin(); it != dirty.rend(); ++it) {
-    Node& node = nodes_[static_cast<size_t>(*it)];
+  for (auto it = dirty.rbegin(); it != dirty.rend(); ++it) refit_nodes(*it, *it);
+}
+
+void AabbTree::refit_nodes(int from, int to) {
+  // Children are created after their parent, so a descending sweep visits children first.
+  for (int i = from; i >= to; --i) {
+    Node& node = nodes_[static_cast<size_t>(i)];
     node.box.setEmpty();
     if (node.left < 0) {
       for (int k = node.first; k < node.first + node.count; ++k)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace stc {
 
@@ -27,7 +28,7 @@ void TetLocator::build(const TetMesh& mesh, std::vector<Vec3> positions,
     tets_.push_back(t);
     boxes.push_back(box);
   }
-  tree_.build(boxes);
+  tree_.build(std::move(boxes));
 }
 
 std::optional<TetLocation> TetLocator::locate(const Vec3& p, double tolerance) const {

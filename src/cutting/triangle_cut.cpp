@@ -524,9 +524,9 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
     const Tet& tet = mesh.tets[t];
     // Any node on the stroke's cut surface may be a corner: a face in the crease between two
     // non-coplanar triangles of the stroke has corners on each; the checks below keep only
-    // faces that lie along this triangle. Each node's side once per tet (a face needs three
-    // corners on the cut, so a tet with fewer has none).
-    // Sides on demand (a node on the stroke is "on" whatever its side).
+    // faces that lie along this triangle. Each node's side at most once per tet, on demand (a
+    // node on the stroke is "on" whatever its side; a tet with fewer than three corners on the
+    // cut has no face on it).
     constexpr int kUnknown = 2;
     std::array<int, 4> sides = {kUnknown, kUnknown, kUnknown, kUnknown};
     auto side_of = [&](int k) {

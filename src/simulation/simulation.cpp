@@ -20,6 +20,7 @@
 #include <chrono>
 #include <deque>
 #include <future>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -229,10 +230,13 @@ struct Simulation::Impl {
   // Inserts the sweep between two blade poses; returns true if the mesh changed. The blade
   // moves through the DEFORMED tissue: its edge is carried to rest coordinates through the
   // current deformation (rest_mapping.hpp) before the rest mesh is cut there.
-  // The current deformation of the operation part, for carrying blade points to rest.
-  std::shared_ptr<DeformedToRest> current_to_rest() const {
+  // The current deformation of the operation part, for carrying blade points to rest: its
+  // tets that reach into [lo, hi] as deformed (all of them by default).
+  std::shared_ptr<DeformedToRest> current_to_rest(
+      const Vec3& lo = Vec3::Constant(-std::numeric_limits<double>::infinity()),
+      const Vec3& hi = Vec3::Constant(std::numeric_limits<double>::infinity())) const {
     auto map = std::make_shared<DeformedToRest>();
-    map->build(model->mesh(), displacements(), model->partition().operation_tet);
+    map->build(model->mesh(), displacements(), model->partition().operation_tets, lo, hi);
     return map;
   }
 
@@ -266,12 +270,10 @@ struct Simulation::Impl {
     if (!frozen) {
       // Every point mapped below lies on the two edges or between them: their box, padded
       // (the locator's own tolerance is barycentric), is all the map needs to cover.
-      Vec3 lo = a.tip.cwiseMin(a.heel).cwiseMin(b.tip).cwiseMin(b.heel);
-      Vec3 hi = a.tip.cwiseMax(a.heel).cwiseMax(b.tip).cwiseMax(b.heel);
+      const Vec3 lo = a.tip.cwiseMin(a.heel).cwiseMin(b.tip).cwiseMin(b.heel);
+      const Vec3 hi = a.tip.cwiseMax(a.heel).cwiseMax(b.tip).cwiseMax(b.heel);
       const double pad = 0.01 * (hi - lo).norm() + 1e-6;
-      built = std::make_shared<DeformedToRest>();
-      built->build(model->mesh(), displacements(), model->partition().operation_tets,
-                   lo.array() - pad, hi.array() + pad);
+      built = current_to_rest(lo.array() - pad, hi.array() + pad);
     }
     const DeformedToRest& to_rest = frozen ? *frozen : *built;
     std::vector<double> params(kSamples);

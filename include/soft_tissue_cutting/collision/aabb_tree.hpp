@@ -14,9 +14,9 @@ using Box3 = Eigen::AlignedBox3d;
 
 class AabbTree {
  public:
-  void build(const std::vector<Box3>& primitive_boxes);
+  void build(std::vector<Box3> primitive_boxes);
   // Same primitives, new boxes (same order as build).
-  void refit(const std::vector<Box3>& primitive_boxes);
+  void refit(std::vector<Box3> primitive_boxes);
   // Same primitives, new boxes for a few of them (primitive index, box): only their leaves and
   // those leaves' ancestors are refitted; the same tree as refit() with every box.
   void refit(const std::vector<std::pair<int, Box3>>& changed);
@@ -34,6 +34,8 @@ class AabbTree {
     int first = 0, count = 0;   // leaf: order_[first, first + count)
   };
   int build_node(const std::vector<Box3>& boxes, int first, int count);
+  // Recomputes the boxes of nodes from, from - 1, ..., to (a node's children come after it).
+  void refit_nodes(int from, int to);
   std::vector<Node> nodes_;
   std::vector<int> order_;
   std::vector<Box3> boxes_;   // per primitive, as last built or refitted
