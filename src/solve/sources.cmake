@@ -5,6 +5,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/solve/cpu_cg_solver.cpp
   src/solve/framed_cholesky.cpp
   src/solve/held_dof_solve.cpp
+  src/solve/interface_last_order.cpp
   src/solve/schur_complement.cpp
   src/solve/sparse_cholesky.cpp
 )

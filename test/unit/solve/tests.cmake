@@ -5,5 +5,6 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/solve/test_cpu_cg_solver.cpp
   test/unit/solve/test_framed_cholesky.cpp
   test/unit/solve/test_held_dof_solve.cpp
+  test/unit/solve/test_interface_last_order.cpp
   test/unit/solve/test_schur_complement.cpp
 )
