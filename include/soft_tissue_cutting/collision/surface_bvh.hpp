@@ -41,6 +41,8 @@ class SurfaceBvh {
  private:
   void update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement);
   std::vector<Box3> triangle_boxes(const std::vector<int>& triangles) const;
+  // The other tree after the positions moved from `previous`: its triangles on a moved node.
+  void refit_other_tree(const std::vector<Vec3>& previous);
   BoundarySurface surface_;
   std::vector<std::uint8_t> operation_;
   std::vector<Vec3> positions_;
