@@ -4,9 +4,11 @@
 #include "solve/interface_last_order.hpp"
 #include "solve/upper_triangle.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 
 #include <algorithm>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -67,6 +69,21 @@ bool same_row(const SparseMatrix& a, const SparseMatrix& b, int r) {
 
 }  // namespace
 
+// The frame's extra rows X and what eqs. (28)-(29) need of them (n_f: the rows of F).
+struct Extra {
+  std::vector<int> rows;       // X, in the order of S's trailing block
+  std::vector<int> positions;  // their places in the elimination order (< n_f)
+  Eigen::MatrixXd y;           // Y = L_FF^-1 E_X                        (n_f x |X|)
+  Eigen::MatrixXd z;           // Z = G E_X = L_FF^-T Y                  (n_f x |X|)
+  Eigen::MatrixXd m;           // M = L_FF^-1 A_FX, X's own rows zeroed  (n_f x |X|)
+  Eigen::MatrixXd q;           // Q = L_BF Y                             (|B| x |X|)
+  Eigen::MatrixXd a_xb;        // A_XB of the factored matrix            (|X| x |B|)
+  Eigen::MatrixXd a_xx;        // A_XX of the factored matrix            (|X| x |X|)
+  Eigen::MatrixXd t;           // T_XX = (Y^T Y)^-1                      (|X| x |X|)
+  Eigen::MatrixXd w;           // W'' over [B, X] (eq. (28)), lower triangle
+  bool empty() const { return rows.empty(); }
+};
+
 struct FramedCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
@@ -78,11 +95,17 @@ struct FramedCholesky::Impl {
   Eigen::MatrixXd w;               // W = A_BB - L_BB L_BB^T, eq. (26) (lower triangle used)
   Eigen::MatrixXd schur;           // the Cholesky factor of S' (lower), once update() took a matrix
   bool updated = false;
+  std::vector<int> position;  // inverse of perm: where row r is eliminated
+
+  // Rows of F that later changes moved into the frame, X (eq. (28)); F' = F \ X. With
+  // G = A_FF^-1 of the factored matrix and E_X its unit columns on X:
+  Extra extra;
 
   Impl() {
     cholmod_start(&common);
     common.print = 0;
   }
+
   ~Impl() {
     if (factor) cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
@@ -114,6 +137,69 @@ struct FramedCholesky::Impl {
     cholmod_free_dense(&x, &c);
     cholmod_finish(&c);
     return out;
+  }
+
+  // `from` with the rows `added` of F moved into the frame as well (eq. (28)): their columns
+  // of Y, Z, M and Q by one forward solve of 2|added| columns and one backward solve of
+  // |added|, then T_XX and W'' anew (dense, |X| small). Rows of A are the factored matrix's.
+  std::optional<Extra> extended(const Extra& from, const std::vector<int>& added) const {
+    const int n_old = static_cast<int>(factored.rows()), nb = n_old - n_f;
+    const int k = static_cast<int>(added.size()), k0 = static_cast<int>(from.rows.size());
+    Extra x = from;
+    x.rows.insert(x.rows.end(), added.begin(), added.end());
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_old, 2 * k);
+    for (int j = 0; j < k; ++j) {
+      const int r = added[static_cast<size_t>(j)];
+      x.positions.push_back(position[static_cast<size_t>(r)]);
+      rhs(position[static_cast<size_t>(r)], j) = 1.0;
+      for (SparseMatrix::InnerIterator it(factored, r); it; ++it)  // A_FX: row r, symmetric
+        if (const int p = position[static_cast<size_t>(it.index())]; p < n_f)
+          rhs(p, k + j) = it.value();
+    }
+    const Eigen::MatrixXd l = triangular_solve(CHOLMOD_L, rhs);
+    Eigen::MatrixXd back = Eigen::MatrixXd::Zero(n_old, k);
+    back.topRows(n_f) = l.topLeftCorner(n_f, k);
+    const Eigen::MatrixXd lt = triangular_solve(CHOLMOD_Lt, back);
+    // L^-1 [E_X; 0] = [Y; -L_BB^-1 L_BF Y], so Q = L_BF Y = -L_BB times its frame rows.
+    Eigen::MatrixXd q = -l.bottomLeftCorner(nb, k);
+    {
+      const auto blas = blas_guard();
+      lower_times(l_bb, false, q);
+    }
+    auto append = [](Eigen::MatrixXd& to, const Eigen::MatrixXd& cols) {
+      Eigen::MatrixXd out(cols.rows(), to.cols() + cols.cols());
+      if (to.cols() > 0) out.leftCols(to.cols()) = to;
+      out.rightCols(cols.cols()) = cols;
+      to = std::move(out);
+    };
+    append(x.y, l.topLeftCorner(n_f, k));
+    append(x.m, l.topRightCorner(n_f, k));
+    append(x.z, lt.topRows(n_f));
+    append(x.q, q);
+    const int nx = k0 + k;
+    x.a_xb = Eigen::MatrixXd::Zero(nx, nb);
+    x.a_xx = Eigen::MatrixXd::Zero(nx, nx);
+    std::vector<int> in_x(static_cast<size_t>(n_old), -1);
+    for (int j = 0; j < nx; ++j) in_x[static_cast<size_t>(x.rows[static_cast<size_t>(j)])] = j;
+    for (int j = 0; j < nx; ++j)
+      for (SparseMatrix::InnerIterator it(factored, x.rows[static_cast<size_t>(j)]); it; ++it) {
+        const int c = static_cast<int>(it.index());
+        if (const int p = position[static_cast<size_t>(c)]; p >= n_f)
+          x.a_xb(j, p - n_f) = it.value();
+        if (const int i = in_x[static_cast<size_t>(c)]; i >= 0) x.a_xx(j, i) = it.value();
+      }
+    // T_XX = (Y^T Y)^-1 = ((A_FF^-1)_XX)^-1, the Schur complement of A_F'F' onto X.
+    const Eigen::LLT<Eigen::MatrixXd> g(x.y.transpose() * x.y);
+    if (g.info() != Eigen::Success) return std::nullopt;
+    x.t = g.solve(Eigen::MatrixXd::Identity(nx, nx));
+    // W'' over [B, X]: W - Q T Q^T, A_XX - T, A_XB - T Q^T (lower triangle).
+    const Eigen::MatrixXd tq = x.t * x.q.transpose();  // |X| x |B|
+    x.w.resize(nb + nx, nb + nx);
+    x.w.topLeftCorner(nb, nb) = w.selfadjointView<Eigen::Lower>();
+    x.w.topLeftCorner(nb, nb).noalias() -= x.q * tq;
+    x.w.bottomRightCorner(nx, nx) = x.a_xx - x.t;
+    x.w.bottomLeftCorner(nx, nb) = x.a_xb - tq;
+    return x;
   }
 };
 
@@ -171,6 +257,8 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
     throw std::logic_error("framed Cholesky: CHOLMOD did not keep the given order");
   m.n_f = n - static_cast<int>(frame.size());
   frame_.assign(m.perm.begin() + m.n_f, m.perm.end());
+  m.position.assign(static_cast<size_t>(n), 0);
+  for (int k = 0; k < n; ++k) m.position[static_cast<size_t>(m.perm[static_cast<size_t>(k)])] = k;
 
   // L_BB from the supernodes (column-major blocks: the rows of supernode s are
   // Ls[pi[s] .. pi[s+1]), its columns super[s] .. super[s+1]).
@@ -220,22 +308,45 @@ bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* chang
   const int n_old = static_cast<int>(m.factored.rows());
   const int n = static_cast<int>(a.rows());
   if (n < n_old || m.factor == nullptr) return false;
+  // Changed rows of F not yet in the frame: they join it as extra rows (eq. (28)) while few.
+  std::vector<int> outside;
+  const auto in_frame = [&](int r) { return m.in_old_frame[static_cast<size_t>(r)] != 0; };
   if (changed) {
-    for (int r : *changed)
-      if (r < 0 || r >= n || (r < n_old && !m.in_old_frame[static_cast<size_t>(r)])) return false;
+    for (int r : *changed) {
+      if (r < 0 || r >= n) return false;
+      if (r < n_old && !in_frame(r)) outside.push_back(r);
+    }
   } else {
     for (int r = 0; r < n_old; ++r)
-      if (!m.in_old_frame[static_cast<size_t>(r)] && !same_row(a, m.factored, r)) return false;
+      if (!in_frame(r) && !same_row(a, m.factored, r)) outside.push_back(r);
   }
-  // The frame: the old one in its elimination order, then the new DOFs.
-  const int nb_old = n_old - m.n_f, nb = nb_old + (n - n_old);
+  std::sort(outside.begin(), outside.end());
+  outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
+  if (static_cast<int>(m.extra.rows.size() + outside.size()) > kMaxExtraRows) return false;
+  std::optional<Extra> extra;
+  if (!outside.empty()) {
+    extra = m.extended(m.extra, outside);
+    if (!extra) return false;
+  }
+  const Extra& x = extra ? *extra : m.extra;
+  // The frame: the old one in its elimination order, the new DOFs, then the extra rows.
+  const int nb_old = n_old - m.n_f, nx = static_cast<int>(x.rows.size());
+  const int nb = nb_old + (n - n_old) + nx;
   std::vector<int> frame(frame_.begin(), frame_.begin() + nb_old);
   for (int r = n_old; r < n; ++r) frame.push_back(r);
+  frame.insert(frame.end(), x.rows.begin(), x.rows.end());
   std::vector<int> pos(static_cast<size_t>(n), -1);
   for (int j = 0; j < nb; ++j) pos[static_cast<size_t>(frame[static_cast<size_t>(j)])] = j;
-  // S' = A'_BB - W (eq. (26)), lower triangle; W is zero on the new DOFs.
+  // S' = A'_BB - W (eq. (26)), lower triangle; W is zero on the new DOFs. With extra rows,
+  // W'' of eq. (28) over the old frame and them.
   Eigen::MatrixXd s = Eigen::MatrixXd::Zero(nb, nb);
-  s.topLeftCorner(nb_old, nb_old) = -m.w;
+  if (x.empty()) {
+    s.topLeftCorner(nb_old, nb_old) = -m.w;
+  } else {
+    s.topLeftCorner(nb_old, nb_old) = -x.w.topLeftCorner(nb_old, nb_old);
+    s.bottomLeftCorner(nx, nb_old) = -x.w.bottomLeftCorner(nx, nb_old);
+    s.bottomRightCorner(nx, nx) = -x.w.bottomRightCorner(nx, nx);
+  }
   for (int j = 0; j < nb; ++j)
     for (SparseMatrix::InnerIterator it(a, frame[static_cast<size_t>(j)]); it; ++it) {
       const int i = pos[static_cast<size_t>(it.index())];
@@ -247,6 +358,10 @@ bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* chang
     dpotrf_("L", &nb, s.data(), &nb, &info);
   }
   if (info != 0) return false;  // not positive definite: the caller refactors (and diagnoses)
+  if (extra) {
+    for (int r : outside) m.in_old_frame[static_cast<size_t>(r)] = 1;
+    m.extra = std::move(*extra);
+  }
   m.schur = std::move(s);
   m.updated = true;
   frame_ = std::move(frame);
@@ -271,23 +386,49 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
     return x;
   }
   // Eq. (27): z = L^-1 P b with the kept factor; its frame rows give r_B = b_B - L_BF z_F.
+  // Extra rows X (eq. (29)): their entries of b are left out of z and enter the frame's solve
+  // with T_XX Y^T z_F; the back substitution then solves with A_F'F' through G and Z.
+  const Extra& ex = m.extra;
+  const int nx = static_cast<int>(ex.rows.size());
   Eigen::MatrixXd bp(n_old, cols);
   for (int k = 0; k < n_old; ++k) bp.row(k) = b.row(m.perm[static_cast<size_t>(k)]);
+  Eigen::MatrixXd b_x(nx, cols);
+  for (int j = 0; j < nx; ++j) {
+    b_x.row(j) = bp.row(ex.positions[static_cast<size_t>(j)]);
+    bp.row(ex.positions[static_cast<size_t>(j)]).setZero();
+  }
   Eigen::MatrixXd z = m.triangular_solve(CHOLMOD_L, bp);
   Eigen::MatrixXd x_b(nb, cols);
   {
     const auto blas = blas_guard();
     Eigen::MatrixXd r_old = z.bottomRows(nb_old);
     lower_times(m.l_bb, false, r_old);
+    for (int j = nb_old; j < nb - nx; ++j) x_b.row(j) = b.row(frame_[static_cast<size_t>(j)]);
+    if (nx > 0) {
+      const Eigen::MatrixXd tq = ex.t * (ex.y.transpose() * z.topRows(m.n_f));  // T_XX q_X
+      r_old.noalias() += ex.q * tq;
+      x_b.bottomRows(nx) = b_x + tq;
+    }
     x_b.topRows(nb_old) = r_old;
-    for (int j = nb_old; j < nb; ++j) x_b.row(j) = b.row(frame_[static_cast<size_t>(j)]);
     cholesky_solve(m.schur, x_b);
     // Back: L^T x_p = [z_F; L_BB^T x_B] returns x_B in its frame rows and x_F above them.
+    if (nx > 0) z.topRows(m.n_f).noalias() -= ex.m * x_b.bottomRows(nx);
     Eigen::MatrixXd top = x_b.topRows(nb_old);
     lower_times(m.l_bb, true, top);
     z.bottomRows(nb_old) = top;
   }
-  const Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
+  Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
+  if (nx > 0) {
+    // xp_F = G v~ with v~ = b_F - A_FX x_X - A_FB x_B; its X rows, -(A_XX x_X + A_XB x_B), are
+    // taken out (G E_X = Z), then the solution's X rows zeroed: u = g - Z T_XX g_X.
+    const Eigen::MatrixXd x_x = x_b.bottomRows(nx);
+    const Eigen::MatrixXd v_x = -(ex.a_xx * x_x + ex.a_xb * x_b.topRows(nb_old));
+    auto g = xp.topRows(m.n_f);
+    g.noalias() -= ex.z * v_x;
+    Eigen::MatrixXd g_x(nx, cols);
+    for (int j = 0; j < nx; ++j) g_x.row(j) = g.row(ex.positions[static_cast<size_t>(j)]);
+    g.noalias() -= ex.z * (ex.t * g_x);
+  }
   Eigen::MatrixXd x(rows_, cols);
   for (int k = 0; k < m.n_f; ++k) x.row(m.perm[static_cast<size_t>(k)]) = xp.row(k);
   for (int j = 0; j < nb; ++j) x.row(frame_[static_cast<size_t>(j)]) = x_b.row(j);

@@ -14,7 +14,10 @@
 //   z = L^-1 P b,  r_B = L_BB z_B (= b_B - L_BF z_F),  x_B = S'^-1 r_B,
 //   x = P^T L^-T [z_F; L_BB^T x_B]
 // (the last solve's trailing block returns x_B itself; only its F rows are new), exact to the
-// rounding of a direct solve.
+// rounding of a direct solve. A later change that reaches a few rows X of F (the blade's next
+// cut one ring past the frame) moves them into the frame without a refactorization: the
+// Schur complement of A_F'F' (F' = F \ X) onto X u B follows from L's solves with X's unit
+// columns, eq. (28), and the solves correct G = A_FF^-1 for X, eq. (29).
 #pragma once
 
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
@@ -28,6 +31,12 @@ namespace stc {
 
 class FramedCholesky final : public CholeskySolve {
  public:
+  // At most this many changed rows outside the frame join it (eq. (28)) before a change
+  // refactors the whole matrix: each costs three column solves with the sparse factor when it
+  // joins, and every later solve a few products of its size. The organ liver's follow stroke
+  // left its frame by 3-24 rows at most of the cuts that refactored.
+  static constexpr int kMaxExtraRows = 48;
+
   // Factors `a` (SPD, both triangles stored) with the DOFs in `frame` eliminated last and the
   // others in AMD order. Throws std::runtime_error if `a` is not positive definite.
   FramedCholesky(const SparseMatrix& a, std::vector<int> frame);
@@ -36,9 +45,10 @@ class FramedCholesky final : public CholeskySolve {
   FramedCholesky& operator=(const FramedCholesky&) = delete;
 
   // Takes `a` by refactoring the frame alone if it can: `a`'s leading rows() rows are the same
-  // DOFs as the factored matrix's, every row outside the frame is unchanged (pattern and values),
-  // and the frame's Schur complement is positive definite. Rows beyond rows() are new DOFs and
-  // join the frame. Returns false, leaving this factor as it was, otherwise.
+  // DOFs as the factored matrix's, at most kMaxExtraRows rows outside the frame changed since
+  // the factorization (pattern or values: they join the frame as extra rows, eq. (28)), and the
+  // frame's Schur complement is positive definite. Rows beyond rows() are new DOFs and join the
+  // frame. Returns false, leaving this factor as it was, otherwise.
   // `changed`, when given, lists every row in which `a` may differ from the factored matrix
   // (the others are taken as equal, not compared).
   bool update(const SparseMatrix& a, const std::vector<int>* changed = nullptr);

@@ -207,46 +207,54 @@ TEST(FramedCholesky, TakesChangesInsideTheFrameAndNewDofsCoupledToIt) {
 }
 
 // With the changed rows named (what the hybrid model knows after a cut), rows outside the list
-// are not compared: a list inside the frame is taken, one with a row outside refused.
+// are not compared: a list inside the frame is taken as it is; a row outside it joins the
+// frame as an extra row (eq. (28)), and either way the factor solves the new matrix exactly.
 TEST(FramedCholesky, TakesTheChangedRowsItIsTold) {
   const Framed f = thigh_matrix();
-  FramedCholesky factor(f.a, f.frame);
   SparseMatrix changed = f.a;
   const int p = f.frame[0];
   changed.coeffRef(p, p) *= 1.25;
-  const std::vector<int> outside = {p, f.outside};
-  EXPECT_FALSE(factor.update(changed, &outside));
-  EXPECT_EQ(factor.updates(), 0);
-  const std::vector<int> inside = {p};
-  ASSERT_TRUE(factor.update(changed, &inside));
   const Vector b = Vector::LinSpaced(f.a.rows(), 1.0, 2.0);
-  EXPECT_LE(relative(factor.solve(b), SparseCholesky(changed).solve(b)), 1e-12);
+  const Vector ref = SparseCholesky(changed).solve(b);
+  FramedCholesky inside_only(f.a, f.frame);
+  const std::vector<int> inside = {p};
+  ASSERT_TRUE(inside_only.update(changed, &inside));
+  EXPECT_EQ(inside_only.frame_size(), static_cast<int>(f.frame.size()));
+  EXPECT_LE(relative(inside_only.solve(b), ref), 1e-12);
+  FramedCholesky with_outside(f.a, f.frame);
+  const std::vector<int> outside = {p, f.outside};
+  ASSERT_TRUE(with_outside.update(changed, &outside));
+  EXPECT_EQ(with_outside.frame_size(), static_cast<int>(f.frame.size()) + 1);
+  EXPECT_LE(relative(with_outside.solve(b), ref), 1e-12);
   EXPECT_EQ(FramedCholesky::frame_around(f.a, {static_cast<int>(f.a.rows()) - 1}, f.dense, 1),
             f.frame);
 }
 
 // A fresh factorization told where the next change is expected (a moved region's new model,
 // LinearSolver::History::expected_rows) frames those rows: a change there then refactors the
-// frame alone, exactly; without the hint the same change refactors the whole matrix.
+// frame alone, exactly; without the hint the same change (more rows than may join a frame)
+// refactors the whole matrix.
 TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
   const Framed f = thigh_matrix();
   const int n = static_cast<int>(f.a.rows());
-  const int p = n - 1;  // f.frame is this row and its neighbours
+  const int p = n - 1;  // f.frame is this row and its neighbours; the change reaches two rings
+  const std::vector<int> frame = FramedCholesky::frame_around(f.a, {p}, f.dense, 2);
+  ASSERT_GT(static_cast<int>(frame.size()), FramedCholesky::kMaxExtraRows);
   SparseMatrix changed = f.a;
-  changed.coeffRef(p, p) *= 1.25;
-  const std::vector<int> rows = {p};
+  for (int r : frame) changed.coeffRef(r, r) *= 1.25;
+  const std::vector<int>& expected = f.frame;  // framed with one ring more: `frame`
   const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
   const Vector ref = SparseCholesky(changed).solve(b);
   for (const bool hint : {true, false}) {
     auto solver = make_cpu_solver();
     LinearSolver::History fresh;
     fresh.interface_rows = f.dense;
-    if (hint) fresh.expected_rows = &rows;
+    if (hint) fresh.expected_rows = &expected;
     solver->set_matrix(f.a, {}, fresh);
     LinearSolver::History cut;
     cut.kept_rows = n;
     cut.interface_rows = f.dense;
-    cut.changed_rows = &rows;
+    cut.changed_rows = &frame;
     solver->set_matrix(changed, {}, cut);
     EXPECT_EQ(solver->frame_updates(), hint ? 1 : 0) << (hint ? "with" : "without") << " the hint";
     Vector x = Vector::Zero(n);
@@ -256,35 +264,75 @@ TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
   }
 }
 
-TEST(FramedCholesky, RefusesChangesOutsideTheFrameAndKeepsItsFactor) {
+// Rows outside the frame join it as extra rows, one change after another, and new DOFs may
+// couple to them; each time the factor solves the new matrix as exactly as a fresh one.
+TEST(FramedCholesky, TakesAFewRowsOutsideTheFrameOneChangeAfterAnother) {
   const Framed f = thigh_matrix();
   FramedCholesky factor(f.a, f.frame);
   const int n = static_cast<int>(f.a.rows());
-  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
-  const Vector ref = SparseCholesky(f.a).solve(b);
-
   SparseMatrix changed = f.a;  // a stiffer DOF outside the frame
   changed.coeffRef(f.outside, f.outside) *= 1.5;
-  EXPECT_FALSE(factor.update(changed));
+  ASSERT_TRUE(factor.update(changed));
+  EXPECT_EQ(factor.frame_size(), static_cast<int>(f.frame.size()) + 1);
+  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
+  EXPECT_LE(relative(factor.solve(b), SparseCholesky(changed).solve(b)), 1e-12);
 
-  // A new DOF coupled to a row outside the frame.
+  // A new DOF coupled to that row and to another row outside the frame, with a stiffer
+  // coupling between the two.
+  int other = -1;
+  std::vector<char> in(static_cast<size_t>(n), 0);
+  for (int r : f.frame) in[static_cast<size_t>(r)] = 1;
+  for (int r = f.outside - 1; r >= f.dense && other < 0; --r)
+    if (!in[static_cast<size_t>(r)] && changed.coeff(r, f.outside) != 0) other = r;
+  ASSERT_GE(other, 0);
   std::vector<Eigen::Triplet<double, int>> t;
   for (int i = 0; i < n; ++i)
-    for (SparseMatrix::InnerIterator it(f.a, i); it; ++it)
+    for (SparseMatrix::InnerIterator it(changed, i); it; ++it)
       t.emplace_back(i, static_cast<int>(it.index()), it.value());
   const double d = f.a.coeff(f.outside, f.outside);
   t.emplace_back(n, n, d);
   t.emplace_back(n, f.outside, -0.1 * d);
   t.emplace_back(f.outside, n, -0.1 * d);
   t.emplace_back(f.outside, f.outside, 0.1 * d);
+  t.emplace_back(other, other, 0.2 * d);
+  t.emplace_back(other, f.outside, -0.1 * d);
+  t.emplace_back(f.outside, other, -0.1 * d);
   SparseMatrix grown(n + 1, n + 1);
   grown.setFromTriplets(t.begin(), t.end());
-  EXPECT_FALSE(factor.update(grown));
+  ASSERT_TRUE(factor.update(grown));
+  EXPECT_EQ(factor.frame_size(), static_cast<int>(f.frame.size()) + 3);
+  EXPECT_EQ(factor.updates(), 2);
+  const Eigen::MatrixXd b2 = two_columns(Vector::LinSpaced(n + 1, -1.0, 3.0));
+  EXPECT_LE(relative(factor.solve(b2), SparseCholesky(grown).solve(b2)), 1e-12);
+  EXPECT_LE(
+      relative(factor.solve(Vector(b2.col(0))), SparseCholesky(grown).solve(Vector(b2.col(0)))),
+      1e-12);
+}
+
+TEST(FramedCholesky, RefusesMoreRowsOutsideTheFrameAndKeepsItsFactor) {
+  const Framed f = thigh_matrix();
+  FramedCholesky factor(f.a, f.frame);
+  const int n = static_cast<int>(f.a.rows());
+  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
+  const Vector ref = SparseCholesky(f.a).solve(b);
+
+  // More stiffer DOFs outside the frame than may join it.
+  SparseMatrix changed = f.a;
+  std::vector<char> in(static_cast<size_t>(n), 0);
+  for (int r : f.frame) in[static_cast<size_t>(r)] = 1;
+  int outside = 0;
+  for (int r = n - 1; r >= f.dense && outside <= FramedCholesky::kMaxExtraRows; --r)
+    if (!in[static_cast<size_t>(r)]) changed.coeffRef(r, r) *= 1.5, ++outside;
+  EXPECT_FALSE(factor.update(changed));
 
   // A frame that is no longer positive definite.
   SparseMatrix indefinite = f.a;
   indefinite.coeffRef(f.frame[0], f.frame[0]) = -1.0;
   EXPECT_FALSE(factor.update(indefinite));
+  // Nor with an extra row (the Schur complement is refused, the extra row not kept).
+  indefinite.coeffRef(f.outside, f.outside) *= 1.5;
+  EXPECT_FALSE(factor.update(indefinite));
+  EXPECT_EQ(factor.frame_size(), static_cast<int>(f.frame.size()));
 
   // Fewer rows than factored.
   EXPECT_FALSE(factor.update(SparseMatrix(f.a.topLeftCorner(n - 1, n - 1))));
