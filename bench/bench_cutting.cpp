@@ -55,7 +55,7 @@ void BM_CuttingSweep(benchmark::State& state) {
     for (int k = 0; k < steps; ++k) {
       const BladeEdge from = edge_at(static_cast<double>(k) / steps),
                       to = edge_at(static_cast<double>(k + 1) / steps);
-      bvh.refit(mesh, {});
+      bvh.refit(mesh, std::vector<Vec3>{});
       const Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * mesh.num_nodes());
       benchmark::DoNotOptimize(contact.update(bvh, mesh, u, previous, to));
       previous = to;

@@ -1,5 +1,6 @@
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace stc {
@@ -72,7 +73,10 @@ void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
   // The organ liver: 18.8k triangles, ~2k of them on the operation part; rebuilding the whole
   // tree after each cut cost ~4 ms of its cutting step, refitting all of it ~0.4 ms.
   if (other_nodes == other_nodes_ && other_tree_.size() == static_cast<int>(other_nodes.size())) {
-    refit_other_tree(previous);
+    std::vector<int> moved;
+    for (size_t v = 0; v < std::min(previous.size(), positions_.size()); ++v)
+      if (positions_[v] != previous[v]) moved.push_back(static_cast<int>(v));
+    refit_other_tree(moved, previous.size());
   } else {
     other_tree_.build(triangle_boxes(other_triangles_));
     other_nodes_ = std::move(other_nodes);
@@ -88,22 +92,50 @@ void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
   }
 }
 
-void SurfaceBvh::refit(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
-  std::vector<Vec3> previous;
-  previous.swap(positions_);
-  update_positions(mesh, displacement);
-  operation_tree_.refit(triangle_boxes(operation_triangles_));
-  refit_other_tree(previous);
+template <typename DisplacementOf>
+std::vector<int> SurfaceBvh::place_nodes(const TetMesh& mesh, DisplacementOf displacement_of) {
+  // One pass: each node's deformed position, compared with the last one in place (copying the
+  // whole mesh's positions and comparing them after cost a follow stroke's steps ~0.2 ms).
+  const size_t n = mesh.nodes.size(), known = std::min(positions_.size(), n);
+  positions_.resize(n);
+  std::vector<int> moved;
+  for (size_t v = 0; v < n; ++v) {
+    const Vec3 p = mesh.nodes[v] + displacement_of(v);
+    if (v < known && p == positions_[v]) continue;
+    positions_[v] = p;
+    if (v < known) moved.push_back(static_cast<int>(v));
+  }
+  return moved;
 }
 
-void SurfaceBvh::refit_other_tree(const std::vector<Vec3>& previous) {
+void SurfaceBvh::refit(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
+  const size_t known = positions_.size();
+  const bool with_u = displacement.size() == mesh.nodes.size();
+  const std::vector<int> moved =
+      place_nodes(mesh, [&](size_t v) -> Vec3 { return with_u ? displacement[v] : Vec3::Zero(); });
+  operation_tree_.refit(triangle_boxes(operation_triangles_));
+  refit_other_tree(moved, known);
+}
+
+void SurfaceBvh::refit(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
+  const size_t known = positions_.size();
+  const bool with_u = displacement.size() == 3 * static_cast<Eigen::Index>(mesh.nodes.size());
+  const std::vector<int> moved = place_nodes(mesh, [&](size_t v) -> Vec3 {
+    return with_u ? Vec3(displacement.segment<3>(3 * static_cast<Eigen::Index>(v))) : Vec3::Zero();
+  });
+  operation_tree_.refit(triangle_boxes(operation_triangles_));
+  refit_other_tree(moved, known);
+}
+
+void SurfaceBvh::refit_other_tree(const std::vector<int>& moved_nodes, size_t known) {
   // The other triangles (a `follow` region's condensed surface: 16.8k of the organ liver's
   // 18.8k) keep their places from one step to the next but for the ~100-150 on interface
   // nodes, until the condensed part's displacement is recovered again: only the triangles
   // whose nodes moved are refitted (a step's refit 0.42 -> ~0.15 ms there). Nodes past
-  // `previous` are new since: on no other triangle (those are the tree's, from its build).
+  // `known` (those whose last positions were known) are new since: on no other triangle
+  // (those are the tree's, from its build).
   const size_t indexed = other_start_.empty() ? 0 : other_start_.size() - 1;
-  if (previous.size() < indexed) {  // positions unknown for some of the tree's nodes
+  if (known < indexed) {  // positions unknown for some of the tree's nodes
     other_tree_.refit(triangle_boxes(other_triangles_));
     return;
   }
@@ -112,15 +144,15 @@ void SurfaceBvh::refit_other_tree(const std::vector<Vec3>& previous) {
   // step on the organ liver ~1 ms more than that refit.
   const size_t most = other_nodes_.size() / 4;
   std::vector<int> primitives;  // of the other tree, on a node that moved
-  for (size_t v = 0; v < indexed; ++v)
-    if (positions_[v] != previous[v]) {
-      primitives.insert(primitives.end(), other_of_node_.begin() + other_start_[v],
-                        other_of_node_.begin() + other_start_[v + 1]);
-      if (primitives.size() > 3 * most) {  // each triangle counted at most three times
-        other_tree_.refit(triangle_boxes(other_triangles_));
-        return;
-      }
+  for (int v : moved_nodes) {
+    if (static_cast<size_t>(v) >= indexed) continue;
+    primitives.insert(primitives.end(), other_of_node_.begin() + other_start_[v],
+                      other_of_node_.begin() + other_start_[v + 1]);
+    if (primitives.size() > 3 * most) {  // each triangle counted at most three times
+      other_tree_.refit(triangle_boxes(other_triangles_));
+      return;
     }
+  }
   std::sort(primitives.begin(), primitives.end());
   primitives.erase(std::unique(primitives.begin(), primitives.end()), primitives.end());
   std::vector<std::pair<int, Box3>> moved;

@@ -773,7 +773,7 @@ struct Simulation::Impl {
   // answers, so with a `follow` region the condensed part is tissue too (the blade may wait
   // there for a move).
   bool edge_inside_tissue(const BladeEdge& edge) {
-    surface_tree.refit(model->mesh(), displacements());
+    surface_tree.refit(model->mesh(), model->operation_displacement());
     return edge_in_tissue(edge, 0.05 * scene.scalpel.blade_length,
                           [&](const Vec3& p) { return surface_tree.contains(p); });
   }
@@ -829,7 +829,7 @@ struct Simulation::Impl {
         contact.release();  // held since the yield (blade_imposed)
         advance_stroke(*blade, edge, s);
       } else {
-        surface_tree.refit(model->mesh(), displacements());
+        surface_tree.refit(model->mesh(), model->operation_displacement());
         std::optional<BladeEdge> previous;
         if (last_pose) previous = blade_edge(*last_pose, length);
         imposed = contact.update(surface_tree, model->mesh(), model->operation_displacement(),

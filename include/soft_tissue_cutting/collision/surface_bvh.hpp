@@ -28,6 +28,8 @@ class SurfaceBvh {
              const std::vector<Vec3>& displacement);
   // Every step (same surface, nodes moved).
   void refit(const TetMesh& mesh, const std::vector<Vec3>& displacement);
+  // The same from the displacement as one vector, 3 per node (empty = rest shape).
+  void refit(const TetMesh& mesh, const Eigen::VectorXd& displacement);
 
   const BoundarySurface& surface() const { return surface_; }
   bool is_operation(int triangle) const { return operation_[triangle] != 0; }
@@ -41,8 +43,13 @@ class SurfaceBvh {
  private:
   void update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement);
   std::vector<Box3> triangle_boxes(const std::vector<int>& triangles) const;
-  // The other tree after the positions moved from `previous`: its triangles on a moved node.
-  void refit_other_tree(const std::vector<Vec3>& previous);
+  // Deformed positions from the rest mesh and displacement_of(v); returns the nodes that moved
+  // among those it had positions for.
+  template <typename DisplacementOf>
+  std::vector<int> place_nodes(const TetMesh& mesh, DisplacementOf displacement_of);
+  // The other tree after `moved_nodes` moved (positions were known for nodes < known): its
+  // triangles on them.
+  void refit_other_tree(const std::vector<int>& moved_nodes, size_t known);
   BoundarySurface surface_;
   std::vector<std::uint8_t> operation_;
   std::vector<Vec3> positions_;

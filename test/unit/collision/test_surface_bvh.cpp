@@ -133,6 +133,15 @@ TEST(CollisionBvh, OperationAndOtherTreesAnswerLikeOneTree) {
   split.build(scene.mesh, operation, moved);
   one.build(scene.mesh, {}, moved);
   same_answers("after a build that moved a few nodes");
+  // The model's displacement as one vector (3 per node), as a step refits from it.
+  Eigen::VectorXd flat(3 * static_cast<Eigen::Index>(moved.size()));
+  for (size_t i = 0; i < moved.size(); ++i) {
+    if (std::abs(scene.mesh.nodes[i].x() - 0.03) < 6e-3) moved[i] += Vec3(-2e-3, 1e-3, 3e-3);
+    flat.segment<3>(3 * static_cast<Eigen::Index>(i)) = moved[i];
+  }
+  split.refit(scene.mesh, flat);
+  one.refit(scene.mesh, moved);
+  same_answers("after a refit from one displacement vector");
 }
 
 }  // namespace
