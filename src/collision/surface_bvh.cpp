@@ -5,6 +5,18 @@
 
 namespace stc {
 
+namespace {
+
+// A displacement per node (empty, or another size than the mesh's: the rest shape) as the
+// function place_nodes reads.
+auto per_node(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
+  const bool with_u = displacement.size() == mesh.nodes.size();
+  return
+      [&displacement, with_u](size_t v) -> Vec3 { return with_u ? displacement[v] : Vec3::Zero(); };
+}
+
+}  // namespace
+
 bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
                               const Vec3& c, double& s) {
   // Moeller-Trumbore on the segment's direction; barycentrics half-open so a ray through a
@@ -27,12 +39,6 @@ bool segment_crosses_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const
   if (v < 0 || u + v >= 1) return false;
   s = e2.dot(k) * inv;
   return s >= 0 && s <= 1;
-}
-
-void SurfaceBvh::update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
-  positions_ = mesh.nodes;
-  if (displacement.size() == mesh.nodes.size())
-    for (size_t i = 0; i < positions_.size(); ++i) positions_[i] += displacement[i];
 }
 
 std::vector<Box3> SurfaceBvh::triangle_boxes(const std::vector<int>& triangles) const {
@@ -66,17 +72,13 @@ void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
     (operation_[i] ? operation_triangles_ : other_triangles_).push_back(static_cast<int>(i));
     if (!operation_[i]) other_nodes.push_back(surface_.triangles[i].nodes);
   }
-  std::vector<Vec3> previous;
-  previous.swap(positions_);
-  update_positions(mesh, displacement);
+  const size_t known = positions_.size();
+  const std::vector<int> moved = place_nodes(mesh, per_node(mesh, displacement));
   operation_tree_.build(triangle_boxes(operation_triangles_));
   // The organ liver: 18.8k triangles, ~2k of them on the operation part; rebuilding the whole
   // tree after each cut cost ~4 ms of its cutting step, refitting all of it ~0.4 ms.
   if (other_nodes == other_nodes_ && other_tree_.size() == static_cast<int>(other_nodes.size())) {
-    std::vector<int> moved;
-    for (size_t v = 0; v < std::min(previous.size(), positions_.size()); ++v)
-      if (positions_[v] != previous[v]) moved.push_back(static_cast<int>(v));
-    refit_other_tree(moved, previous.size());
+    refit_other_tree(moved, known);
   } else {
     other_tree_.build(triangle_boxes(other_triangles_));
     other_nodes_ = std::move(other_nodes);
@@ -109,20 +111,20 @@ std::vector<int> SurfaceBvh::place_nodes(const TetMesh& mesh, DisplacementOf dis
 }
 
 void SurfaceBvh::refit(const TetMesh& mesh, const std::vector<Vec3>& displacement) {
-  const size_t known = positions_.size();
-  const bool with_u = displacement.size() == mesh.nodes.size();
-  const std::vector<int> moved =
-      place_nodes(mesh, [&](size_t v) -> Vec3 { return with_u ? displacement[v] : Vec3::Zero(); });
-  operation_tree_.refit(triangle_boxes(operation_triangles_));
-  refit_other_tree(moved, known);
+  refit_placed(mesh, per_node(mesh, displacement));
 }
 
 void SurfaceBvh::refit(const TetMesh& mesh, const Eigen::VectorXd& displacement) {
-  const size_t known = positions_.size();
   const bool with_u = displacement.size() == 3 * static_cast<Eigen::Index>(mesh.nodes.size());
-  const std::vector<int> moved = place_nodes(mesh, [&](size_t v) -> Vec3 {
+  refit_placed(mesh, [&](size_t v) -> Vec3 {
     return with_u ? Vec3(displacement.segment<3>(3 * static_cast<Eigen::Index>(v))) : Vec3::Zero();
   });
+}
+
+template <typename DisplacementOf>
+void SurfaceBvh::refit_placed(const TetMesh& mesh, DisplacementOf displacement_of) {
+  const size_t known = positions_.size();
+  const std::vector<int> moved = place_nodes(mesh, displacement_of);
   operation_tree_.refit(triangle_boxes(operation_triangles_));
   refit_other_tree(moved, known);
 }

@@ -206,7 +206,8 @@ class CpuCgSolver final : public LinearSolver {
       same.iterations = 0;
       return same;
     }
-    const bool check_warm = !last_;
+    // A cut's matrix is not solved by the last solution either: no product to find out.
+    const bool check_warm = !last_ && !matrix_is_new_;
     CgResult result = solve_system(b, x, constrained, settings, check_warm);
     last_ = LastSolve{b, x, constrained, result};
     return result;
@@ -257,13 +258,9 @@ class CpuCgSolver final : public LinearSolver {
     // (b_k - A_kh x_h). Projected CG would need as many iterations as this solve constrains
     // kept DOFs (a press after a cut freed pieces: 9 iterations, 5.5 ms on the organ liver).
     const bool kept_direct = !kept_.empty() && held_mask_.cwiseProduct(free_mask).isZero(0);
-    const bool cut_matrix = matrix_is_new_;  // its first solve only
-    matrix_is_new_ = false;
     if (chol_ && (kept_.empty() || kept_direct) && settings.max_iterations > 0) {
-      // A cut's matrix is not solved by the last solution: no product to find out.
-      const double warm = cut_matrix || !check_warm
-                              ? std::numeric_limits<double>::infinity()
-                              : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
+      const double warm = !check_warm ? std::numeric_limits<double>::infinity()
+                                      : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
       if (warm > settings.tolerance) {
         Vector direct = x;
         if (kept_.empty()) {
@@ -450,7 +447,7 @@ class CpuCgSolver final : public LinearSolver {
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
   SparseMatrix previous_;       // the block before the last set_matrix (its arrays reused)
-  bool matrix_is_new_ = false;  // a cut's set_matrix, not solved with since
+  bool matrix_is_new_ = false;  // set by a cut: its first solve checks no warm start
   // The last solve since set_matrix: its system (b, constrained DOFs), its answer x and result.
   struct LastSolve {
     Vector b, x;

@@ -75,7 +75,7 @@ struct Extra {
   std::vector<int> positions;  // their places in the elimination order (< n_f)
   Eigen::MatrixXd y;           // Y = L_FF^-1 E_X                        (n_f x |X|)
   Eigen::MatrixXd z;           // Z = G E_X = L_FF^-T Y                  (n_f x |X|)
-  Eigen::MatrixXd m;           // M = L_FF^-1 A_FX, X's own rows zeroed  (n_f x |X|)
+  Eigen::MatrixXd m;           // M = L_FF^-1 A_FX                       (n_f x |X|)
   Eigen::MatrixXd q;           // Q = L_BF Y                             (|B| x |X|)
   Eigen::MatrixXd a_xb;        // A_XB of the factored matrix            (|X| x |B|)
   Eigen::MatrixXd a_xx;        // A_XX of the factored matrix            (|X| x |X|)
@@ -87,18 +87,17 @@ struct Extra {
 struct FramedCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
-  SparseMatrix factored;           // the matrix L L^T is of: its F rows are the reference
-  std::vector<int> perm;           // elimination order: perm[k] is the row eliminated k-th
-  int n_f = 0;                     // rows of F (perm[0, n_f)); the old frame is perm[n_f, n)
-  std::vector<char> in_old_frame;  // per factored row
-  Eigen::MatrixXd l_bb;            // L's trailing frame block (lower, column-major)
-  Eigen::MatrixXd w;               // W = A_BB - L_BB L_BB^T, eq. (26) (lower triangle used)
-  Eigen::MatrixXd schur;           // the Cholesky factor of S' (lower), once update() took a matrix
+  SparseMatrix factored;       // the matrix L L^T is of: its F rows are the reference
+  std::vector<int> perm;       // elimination order: perm[k] is the row eliminated k-th
+  int n_f = 0;                 // rows of F (perm[0, n_f)); the old frame is perm[n_f, n)
+  std::vector<char> in_frame;  // per factored row: in the frame (its extra rows too)
+  Eigen::MatrixXd l_bb;        // L's trailing frame block (lower, column-major)
+  Eigen::MatrixXd w;           // W = A_BB - L_BB L_BB^T, eq. (26) (lower triangle used)
+  Eigen::MatrixXd schur;       // the Cholesky factor of S' (lower), once update() took a matrix
   bool updated = false;
   std::vector<int> position;  // inverse of perm: where row r is eliminated
 
-  // Rows of F that later changes moved into the frame, X (eq. (28)); F' = F \ X. With
-  // G = A_FF^-1 of the factored matrix and E_X its unit columns on X:
+  // Rows of F that later changes moved into the frame, X (eq. (28)); F' = F \ X.
   Extra extra;
 
   Impl() {
@@ -209,12 +208,12 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
   Impl& m = *impl_;
   const int n = rows_;
   m.factored = a;
-  m.in_old_frame.assign(static_cast<size_t>(n), 0);
+  m.in_frame.assign(static_cast<size_t>(n), 0);
   std::sort(frame.begin(), frame.end());
   frame.erase(std::unique(frame.begin(), frame.end()), frame.end());
   for (int r : frame) {
     if (r < 0 || r >= n) throw std::invalid_argument("FramedCholesky: frame row out of range");
-    m.in_old_frame[static_cast<size_t>(r)] = 1;
+    m.in_frame[static_cast<size_t>(r)] = 1;
   }
   if (n == 0) return;
 
@@ -227,8 +226,8 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
   // that order as given and does not postorder it: a postorder may move F columns behind
   // frame columns.
   const std::vector<char> dense = dense_rows(a);
-  m.perm = order_dense_last(upper, dense, m.in_old_frame, m.common);
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> star;
+  m.perm = order_dense_last(upper, dense, m.in_frame, m.common);
+  ColMatrix star;
   cholmod_sparse pattern = view;
   if (const auto hub = std::find_if(m.perm.begin(), m.perm.end(),
                                     [&](int r) { return dense[static_cast<size_t>(r)] != 0; });
@@ -310,15 +309,15 @@ bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* chang
   if (n < n_old || m.factor == nullptr) return false;
   // Changed rows of F not yet in the frame: they join it as extra rows (eq. (28)) while few.
   std::vector<int> outside;
-  const auto in_frame = [&](int r) { return m.in_old_frame[static_cast<size_t>(r)] != 0; };
+  const auto framed = [&](int r) { return m.in_frame[static_cast<size_t>(r)] != 0; };
   if (changed) {
     for (int r : *changed) {
       if (r < 0 || r >= n) return false;
-      if (r < n_old && !in_frame(r)) outside.push_back(r);
+      if (r < n_old && !framed(r)) outside.push_back(r);
     }
   } else {
     for (int r = 0; r < n_old; ++r)
-      if (!in_frame(r) && !same_row(a, m.factored, r)) outside.push_back(r);
+      if (!framed(r) && !same_row(a, m.factored, r)) outside.push_back(r);
   }
   std::sort(outside.begin(), outside.end());
   outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
@@ -359,7 +358,7 @@ bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* chang
   }
   if (info != 0) return false;  // not positive definite: the caller refactors (and diagnoses)
   if (extra) {
-    for (int r : outside) m.in_old_frame[static_cast<size_t>(r)] = 1;
+    for (int r : outside) m.in_frame[static_cast<size_t>(r)] = 1;
     m.extra = std::move(*extra);
   }
   m.schur = std::move(s);

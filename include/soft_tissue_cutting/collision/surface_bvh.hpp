@@ -41,12 +41,14 @@ class SurfaceBvh {
   bool contains(const Vec3& p) const;
 
  private:
-  void update_positions(const TetMesh& mesh, const std::vector<Vec3>& displacement);
   std::vector<Box3> triangle_boxes(const std::vector<int>& triangles) const;
   // Deformed positions from the rest mesh and displacement_of(v); returns the nodes that moved
   // among those it had positions for.
   template <typename DisplacementOf>
   std::vector<int> place_nodes(const TetMesh& mesh, DisplacementOf displacement_of);
+  // A step's refit: place_nodes, the operation tree refitted, the other one where it moved.
+  template <typename DisplacementOf>
+  void refit_placed(const TetMesh& mesh, DisplacementOf displacement_of);
   // The other tree after `moved_nodes` moved (positions were known for nodes < known): its
   // triangles on them.
   void refit_other_tree(const std::vector<int>& moved_nodes, size_t known);
