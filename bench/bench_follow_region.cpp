@@ -172,7 +172,8 @@ BENCHMARK(BM_StepDuringMove)
 // config/scenes/thigh_follow.yaml (7k tets, 2.5 cm ball), pressed in and drawn 10 cm at
 // 0.5 mm per step; organ scale: the liver above (2 cm ball), pressed 1 cm in and drawn 4 cm
 // at 0.05 mm per step (5 mm/s). Counters: every step's wall time (median, p90, max), the
-// steps that swapped a moved region in and those that cut (median, max), moves, tets added.
+// steps that swapped a moved region in and those that cut (median, max; and the medians of a
+// cutting step's phases: collision, insertion, model update, solve), moves, tets added.
 void BM_OnlineFollowStroke(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));
   Scene scene;
@@ -203,6 +204,8 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
     line(in + Vec3(0.04, 0, 0), in + Vec3(0.04, 0.022, 0), 20, q);
   }
   std::vector<double> steps, swaps, cuts;
+  // Where a cutting step goes: its phases' medians (Simulation's StepStats).
+  std::vector<double> cut_collision, cut_insertion, cut_update, cut_solve;
   int moves = 0, tets_added = 0;
   for (auto _ : state) {
     state.PauseTiming();
@@ -215,7 +218,13 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
       const StepStats s = sim.step(pose);
       steps.push_back(s.step_ms);
       if (s.region_moved) swaps.push_back(s.step_ms);
-      if (s.cutting) cuts.push_back(s.step_ms);
+      if (s.cutting) {
+        cuts.push_back(s.step_ms);
+        cut_collision.push_back(s.collision_ms);
+        cut_insertion.push_back(s.cutting_ms);
+        cut_update.push_back(s.assembly_ms);
+        cut_solve.push_back(s.solve_ms);
+      }
       std::this_thread::sleep_until(next);
     }
     moves = sim.region_moves()->moves;
@@ -233,6 +242,10 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
   state.counters["swap_max_ms"] = at(swaps, 1.0);
   state.counters["cutting_median_ms"] = at(cuts, 0.5);
   state.counters["cutting_max_ms"] = at(cuts, 1.0);
+  state.counters["cutting_collision_median_ms"] = at(cut_collision, 0.5);
+  state.counters["cutting_insertion_median_ms"] = at(cut_insertion, 0.5);
+  state.counters["cutting_model_update_median_ms"] = at(cut_update, 0.5);
+  state.counters["cutting_solve_median_ms"] = at(cut_solve, 0.5);
   state.counters["moves"] = moves;
   state.counters["tets_added"] = tets_added;
   state.SetLabel(which == 0 ? "thigh_follow (paper scale), 0.5 mm per 10 ms step"

@@ -12,6 +12,7 @@
 // Usage: tissue_display_timing SCENE.yaml [seconds per mode (10)] [rounds (2)]
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -129,6 +130,7 @@ void run(const stc::Scene& scene, bool display_thread, double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  stc::reexec_with_native_blas_kernels(argv);  // before anything runs (blas_kernels.hpp)
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s SCENE.yaml [seconds per mode] [rounds]\n", argv[0]);
     return 2;

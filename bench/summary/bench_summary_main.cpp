@@ -9,6 +9,7 @@
 
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -46,6 +47,7 @@ std::vector<stc::BenchCase> all_cases() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  stc::reexec_with_native_blas_kernels(argv);  // before anything runs (blas_kernels.hpp)
   std::string out, cases = "thigh1,thigh2,liver_organ,liver_200k";
   double step_mm = 1.0;
   int idle_steps = 50;

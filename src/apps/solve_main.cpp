@@ -5,6 +5,7 @@
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
 #include "soft_tissue_cutting/simulation/step_times.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -26,6 +27,7 @@ int usage(const char* why) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  stc::reexec_with_native_blas_kernels(argv);  // before anything runs (blas_kernels.hpp)
   std::string scene_path, out, stats, backend;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];

@@ -1,6 +1,7 @@
 // tissue_node: the ROS 1 face of the simulation (docs/ROS.md "API"). See tissue_node.hpp.
 #include "soft_tissue_cutting/ros/heap_release.hpp"
 #include "soft_tissue_cutting/ros/tissue_node.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 
 #include <ros/ros.h>
 
@@ -9,7 +10,8 @@
 #include <string>
 
 int main(int argc, char** argv) {
-  stc::ros_io::configure_heap();  // heap_release.hpp: RSS that follows what is in use
+  stc::reexec_with_native_blas_kernels(argv);  // before anything runs (blas_kernels.hpp)
+  stc::ros_io::configure_heap();               // heap_release.hpp: RSS that follows what is in use
   ros::init(argc, argv, "tissue");
   ros::NodeHandle nh, pnh("~");
   stc::ros_io::NodeParams params;

@@ -2,6 +2,7 @@
 list(APPEND TISSUE_CORE_SOURCES
   src/solve/backend.cpp
   src/solve/blas_guard.cpp
+  src/solve/blas_kernels.cpp
   src/solve/cpu_cg_solver.cpp
   src/solve/framed_cholesky.cpp
   src/solve/held_dof_solve.cpp
