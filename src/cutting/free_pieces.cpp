@@ -1,8 +1,9 @@
 #include "cutting/free_pieces.hpp"
 
+#include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+
 #include <algorithm>
 #include <numeric>
-#include <unordered_map>
 
 namespace stc {
 namespace {
@@ -42,27 +43,15 @@ std::vector<MeshPiece> mesh_pieces(const TetMesh& mesh) {
 }
 
 std::vector<MeshPiece> face_connected_pieces(const TetMesh& mesh) {
+  // Union-find over tets: the users of one face (neighbours in faces_by_key) are one piece.
   std::vector<int> parent(mesh.tets.size());
   std::iota(parent.begin(), parent.end(), 0);
-  std::unordered_map<std::uint64_t, int> first_tet;
-  first_tet.reserve(4 * mesh.tets.size());
-  for (int t = 0; t < mesh.num_tets(); ++t)
-    for (int f = 0; f < 4; ++f) {
-      std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
-                                mesh.tets[t][kTetFaces[f][2]]};
-      std::sort(key.begin(), key.end());
-      const std::uint64_t h = (static_cast<std::uint64_t>(key[0]) << 42) ^
-                              (static_cast<std::uint64_t>(key[1]) << 21) ^
-                              static_cast<std::uint64_t>(key[2]);
-      auto [it, inserted] = first_tet.emplace(h, t);
-      if (inserted) continue;
-      const Tet& o = mesh.tets[it->second];
-      int shared = 0;  // guard against a hash collision: the faces must share all 3 nodes
-      for (int v : key) shared += std::find(o.begin(), o.end(), v) != o.end();
-      if (shared != 3) continue;
-      const int a = find_root(parent, t), b = find_root(parent, it->second);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+  const std::vector<KeyedFace> faces = faces_by_key(mesh);
+  for (size_t i = 1; i < faces.size(); ++i) {
+    if (faces[i].key != faces[i - 1].key) continue;
+    const int a = find_root(parent, faces[i].tet), b = find_root(parent, faces[i - 1].tet);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
   std::vector<int> piece_of_root(mesh.tets.size(), -1);
   std::vector<MeshPiece> pieces;
   for (int t = 0; t < mesh.num_tets(); ++t) {

@@ -1,6 +1,8 @@
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 namespace stc {
@@ -18,29 +20,49 @@ struct FaceUse {
 
 }  // namespace
 
-BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
-  // Key each face by its sorted node triple; a boundary face is used by exactly one tet.
-  // One flat array sorted by key (rather than a map) keeps this cheap enough to redo after
-  // every cut.
-  struct FaceEntry {
-    std::array<int, 3> key;
-    int tet;
-    int face;
-    bool operator<(const FaceEntry& o) const {
-      return key != o.key ? key < o.key : (tet != o.tet ? tet < o.tet : face < o.face);
-    }
+std::vector<KeyedFace> faces_by_key(const TetMesh& mesh) {
+  // Two passes: a counting sort on the smallest node, then each node's few faces sorted by the
+  // other two. One std::sort of every face (with std::array's memcmp comparisons) took 61 ms
+  // on the organ liver's 284k faces, this 15-18 ms; a region move extracts two surfaces.
+  const size_t nodes = mesh.nodes.size();
+  auto sorted_key = [&mesh](int t, int f) {
+    std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
+                              mesh.tets[t][kTetFaces[f][2]]};
+    if (key[0] > key[1]) std::swap(key[0], key[1]);
+    if (key[1] > key[2]) std::swap(key[1], key[2]);
+    if (key[0] > key[1]) std::swap(key[0], key[1]);
+    return key;
   };
-  std::vector<FaceEntry> faces;
-  faces.reserve(4 * mesh.tets.size());
-  for (int t = 0; t < mesh.num_tets(); ++t) {
+  std::vector<int> start(nodes + 1, 0);
+  for (int t = 0; t < mesh.num_tets(); ++t)
     for (int f = 0; f < 4; ++f) {
-      std::array<int, 3> key = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]],
-                                mesh.tets[t][kTetFaces[f][2]]};
-      std::sort(key.begin(), key.end());
-      faces.push_back({key, t, f});
+      const std::array<int, 3> key = sorted_key(t, f);
+      if (key[0] < 0 || static_cast<size_t>(key[2]) >= nodes)
+        throw std::invalid_argument("faces_by_key: tetrahedron " + std::to_string(t) +
+                                    " refers to a node outside the mesh");
+      ++start[static_cast<size_t>(key[0]) + 1];
     }
-  }
-  std::sort(faces.begin(), faces.end());
+  for (size_t v = 0; v < nodes; ++v) start[v + 1] += start[v];
+  std::vector<KeyedFace> faces(static_cast<size_t>(start[nodes]));
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const std::array<int, 3> key = sorted_key(t, f);
+      faces[static_cast<size_t>(next[static_cast<size_t>(key[0])]++)] = {key, t, f};
+    }
+  for (size_t v = 0; v < nodes; ++v)
+    std::sort(faces.begin() + start[v], faces.begin() + start[v + 1],
+              [](const KeyedFace& a, const KeyedFace& b) {
+                if (a.key[1] != b.key[1]) return a.key[1] < b.key[1];
+                if (a.key[2] != b.key[2]) return a.key[2] < b.key[2];
+                return a.tet < b.tet;
+              });
+  return faces;
+}
+
+BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
+  // A boundary face is used by exactly one tet.
+  const std::vector<KeyedFace> faces = faces_by_key(mesh);
   BoundarySurface surface;
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;

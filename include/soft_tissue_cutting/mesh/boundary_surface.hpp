@@ -3,6 +3,9 @@
 
 #include "soft_tissue_cutting/mesh/tet_mesh.hpp"
 
+#include <array>
+#include <vector>
+
 namespace stc {
 
 struct BoundaryTriangle {
@@ -20,6 +23,18 @@ struct BoundarySurface {
 };
 
 BoundarySurface extract_boundary_surface(const TetMesh& mesh);
+
+// A face of a tet under its sorted node triple.
+struct KeyedFace {
+  std::array<int, 3> key;  // its nodes, ascending
+  int tet;
+  int face;  // local face index (kTetFaces)
+};
+
+// Every face of every tet, ordered by key, then tet: the tets that share a face are neighbours
+// in it. Linear time (a counting sort on the smallest node). Throws std::invalid_argument for
+// a tet that refers to a node outside the mesh.
+std::vector<KeyedFace> faces_by_key(const TetMesh& mesh);
 
 // Nodes used by at least one boundary triangle, ascending.
 std::vector<int> boundary_nodes(const BoundarySurface& surface);
