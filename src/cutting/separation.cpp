@@ -169,13 +169,24 @@ void keep_slivers_attached(TetMesh& mesh, const CutState& state,
     }
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  // Each tet's neighbour across a face, looked up once: the tets do not change here (marks
+  // only), and the searches below overlap (the organ liver's follow stroke: this function
+  // ~0.55 -> ~0.42 s of 442 cuts, most of it in neighbour_across).
+  std::unordered_map<long, int> across_cache;
+  auto across = [&](int t, int f) {
+    const long key = 4L * t + f;
+    if (const auto it = across_cache.find(key); it != across_cache.end()) return it->second;
+    const int other = neighbour_across(mesh, state, t, f).first;
+    across_cache.emplace(key, other);
+    return other;
+  };
   // The tets reachable from seed through unmarked interior faces, up to just over the limit.
   auto piece_of = [&](int seed) {
     std::vector<int> piece = {seed};
     for (size_t i = 0; i < piece.size() && piece.size() <= kSliverPieceTets; ++i)
       for (int f = 0; f < 4; ++f) {
         if (mesh.is_cut_face(piece[i], f)) continue;
-        const int other = neighbour_across(mesh, state, piece[i], f).first;
+        const int other = across(piece[i], f);
         if (other >= 0 && std::find(piece.begin(), piece.end(), other) == piece.end())
           piece.push_back(other);
       }
@@ -192,7 +203,7 @@ void keep_slivers_attached(TetMesh& mesh, const CutState& state,
       for (int t : piece)
         for (int f = 0; f < 4; ++f) {
           if (!is_interior_marked(mesh, state, t, f)) continue;
-          const int other = neighbour_across(mesh, state, t, f).first;
+          const int other = across(t, f);
           if (std::find(piece.begin(), piece.end(), other) != piece.end()) continue;
           const int score = 2 * (piece_of(other).size() > kSliverPieceTets) +
                             (new_faces.count(face_key(mesh.tets[t], f)) > 0);
