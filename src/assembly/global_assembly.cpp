@@ -127,6 +127,7 @@ SparseMatrix assemble_block(const TetMesh& mesh, const ElementStiffnessCache& el
 void add_difference(SparseMatrix& a, const SparseMatrix& d,
                     const std::vector<std::uint8_t>& touched, double drop, SparseMatrix& spare) {
   const int n = static_cast<int>(d.rows()), n_old = static_cast<int>(a.rows());
+  a.makeCompressed();
   Vector diag = Vector::Zero(n);
   diag.head(n_old) = a.diagonal();
   diag += d.diagonal();
@@ -134,21 +135,28 @@ void add_difference(SparseMatrix& a, const SparseMatrix& d,
     return touched[static_cast<size_t>(c)] &&
            std::abs(v) <= drop * std::sqrt(std::abs(diag[r] * diag[c]));
   };
-  spare.resize(n, n);
-  spare.resizeNonZeros(a.nonZeros() + d.nonZeros());
-  int* outer = spare.outerIndexPtr();
+  // The rows before the first touched one stay where they are (on the hybrid matrix: the dense
+  // interface rows, most of its entries, unless the cut reached them); the rest is rebuilt in
+  // `spare` and copied after them.
+  int first = 0;
+  while (first < n && first < n_old && !touched[static_cast<size_t>(first)]) ++first;
+  const int base = first < n_old ? a.outerIndexPtr()[first] : static_cast<int>(a.nonZeros());
+  const int tail_old = static_cast<int>(a.nonZeros()) - base;
+  spare.resize(1, 1);  // its arrays only: inner indices and values of the tail
+  spare.resizeNonZeros(tail_old + d.nonZeros());
   int* inner = spare.innerIndexPtr();
   double* value = spare.valuePtr();
+  std::vector<int> outer(static_cast<size_t>(n - first) + 1);
   const int* ai = a.innerIndexPtr();
   const double* av = a.valuePtr();
   const int* di = d.innerIndexPtr();
   const double* dv = d.valuePtr();
   int k = 0;
-  for (int r = 0; r < n; ++r) {
-    outer[r] = k;
+  for (int r = first; r < n; ++r) {
+    outer[static_cast<size_t>(r - first)] = k;
     const int a0 = r < n_old ? a.outerIndexPtr()[r] : 0;
     const int a1 = r < n_old ? a.outerIndexPtr()[r + 1] : 0;
-    if (!touched[static_cast<size_t>(r)]) {  // the dense interface rows, most entries: in bulk
+    if (!touched[static_cast<size_t>(r)]) {  // copied bit for bit
       std::copy(ai + a0, ai + a1, inner + k);
       std::copy(av + a0, av + a1, value + k);
       k += a1 - a0;
@@ -170,9 +178,13 @@ void add_difference(SparseMatrix& a, const SparseMatrix& d,
       inner[k] = c, value[k++] = v;
     }
   }
-  outer[n] = k;
-  spare.resizeNonZeros(k);
-  a.swap(spare);
+  outer[static_cast<size_t>(n - first)] = k;
+  a.conservativeResize(n, n);  // new rows empty; the compressed prefix kept
+  a.resizeNonZeros(base + k);  // keeps the first `base` entries
+  std::copy(inner, inner + k, a.innerIndexPtr() + base);
+  std::copy(value, value + k, a.valuePtr() + base);
+  for (int r = first; r <= n; ++r)
+    a.outerIndexPtr()[r] = base + outer[static_cast<size_t>(r - first)];
 }
 
 DofMap make_dof_map(int num_nodes, const std::vector<int>& nodes,

@@ -43,8 +43,8 @@ SparseMatrix assemble_block(const TetMesh& mesh, const ElementStiffnessCache& el
 // not touch are copied bit for bit, the touched ones merged, and d may have more rows (new DOFs,
 // appended). An entry in a touched row and a touched column that sums to within
 // `drop` x sqrt(|a_rr a_cc|) of zero is dropped: couplings the change removed cancel to
-// rounding, not to zero. Written into `spare` (its arrays re-used, not fresh pages) and
-// swapped into a.
+// rounding, not to zero. In place from the first touched row on (the rows before it are not
+// moved); `spare` holds the rebuilt rows meanwhile (its arrays re-used, not fresh pages).
 void add_difference(SparseMatrix& a, const SparseMatrix& d,
                     const std::vector<std::uint8_t>& touched, double drop, SparseMatrix& spare);
 

@@ -104,5 +104,55 @@ TEST(GlobalAssembly, AddDifferenceKeepsUntouchedRowsAndDropsWhatCancels) {
       EXPECT_NE(it.value(), 0.0) << r << ", " << it.index();
 }
 
+// The rows before the first touched one are kept in place and the rest rebuilt: against a + d
+// computed densely, for changes that begin at every row (none, the first, the middle, new rows
+// only), with new DOFs appended.
+TEST(GlobalAssembly, AddDifferenceEqualsTheDenseSumWhereverTheChangeBegins) {
+  const int n_old = 24, n = 27;
+  std::vector<Triplet> ta;
+  for (int r = 0; r < n_old; ++r) {
+    ta.emplace_back(r, r, 10.0 + r);
+    for (int c = r + 1; c < n_old; c += 1 + (r * 7 + c) % 5) {
+      const double v = -0.1 * (1 + (r + 2 * c) % 7);
+      ta.emplace_back(r, c, v);
+      ta.emplace_back(c, r, v);
+    }
+  }
+  SparseMatrix a0(n_old, n_old);
+  a0.setFromTriplets(ta.begin(), ta.end());
+  for (int first : {0, 1, 11, n_old - 1, n_old}) {
+    std::vector<Triplet> td;
+    std::vector<std::uint8_t> touched(static_cast<size_t>(n), 0);
+    for (int r = first; r < n; r += 3)
+      for (int c = first; c < n; c += 4) {
+        const double v = 0.05 * (1 + (r + c) % 3);
+        td.emplace_back(r, c, v);
+        td.emplace_back(c, r, v);
+        touched[static_cast<size_t>(r)] = touched[static_cast<size_t>(c)] = 1;
+      }
+    for (int r = n_old; r < n; ++r) {
+      td.emplace_back(r, r, 5.0);
+      touched[static_cast<size_t>(r)] = 1;
+    }
+    SparseMatrix d(n, n);
+    d.setFromTriplets(td.begin(), td.end());
+    SparseMatrix a = a0, spare;
+    add_difference(a, d, touched, 1e-12, spare);
+    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(n, n);
+    expected.topLeftCorner(n_old, n_old) = Eigen::MatrixXd(a0);
+    expected += Eigen::MatrixXd(d);
+    ASSERT_EQ(a.rows(), n) << first;
+    ASSERT_TRUE(a.isCompressed()) << first;
+    EXPECT_EQ((Eigen::MatrixXd(a) - expected).cwiseAbs().maxCoeff(), 0.0) << first;
+    EXPECT_EQ(a.nonZeros(), (expected.array() != 0).count()) << first;  // no stored zeros
+    for (int r = 0; r < first && r < n_old; ++r)  // untouched rows: bit for bit
+      for (SparseMatrix::InnerIterator it(a, r), ref(a0, r); it || ref; ++it, ++ref) {
+        ASSERT_TRUE(it && ref) << first << " row " << r;
+        EXPECT_EQ(it.index(), ref.index());
+        EXPECT_EQ(it.value(), ref.value());
+      }
+  }
+}
+
 }  // namespace
 }  // namespace stc
