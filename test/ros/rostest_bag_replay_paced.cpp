@@ -10,6 +10,7 @@
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/ros/conversions.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
@@ -100,6 +101,9 @@ TEST(BagReplayPaced, EveryPoseIsSteppedOnAtAnyPace) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
+  // core is compared with the node's output bit for bit.
+  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_bag_replay_paced");
   ros::NodeHandle nh;

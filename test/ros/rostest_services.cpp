@@ -3,6 +3,7 @@
 // gains cut faces, ~set_cutting, ~save writes a readable VTK (errors come back, no crash).
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/simulation/simulation.hpp"
+#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <gtest/gtest.h>
@@ -261,6 +262,9 @@ TEST_F(Fixture, SaveToBadPathReportsErrorAndNodeLivesOn) {
 }
 
 int main(int argc, char** argv) {
+  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
+  // core is compared with the node's output bit for bit.
+  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_services");
   ros::NodeHandle nh;
