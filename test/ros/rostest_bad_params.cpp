@@ -2,8 +2,6 @@
 // parameter and exit status 2 (a bad scene: 1), instead of running on a default: ros::param
 // keeps the default when the type is wrong (`_rate:=fast` used to step at 100 Hz). An int
 // where a number is asked (`_rate:=50`) is a number: that node starts and steps.
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
-
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <soft_tissue_cutting/SimStats.h>
@@ -88,9 +86,6 @@ TEST(BadParams, AnIntWhereANumberIsAskedIsANumber) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_bad_params");
   ros::NodeHandle nh;

@@ -1,6 +1,5 @@
 // (c) Bad poses are dropped, the node keeps publishing ~stats at its rate. The blade drawn in
 // ~markers (namespace scalpel, id 0) shows which pose the node is using.
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -164,9 +163,6 @@ TEST_F(Fixture, PoseInOtherFrameIsTransformedAtLatestTime) {
 }
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_bad_poses");
   ros::NodeHandle nh;

@@ -3,7 +3,6 @@
 // the cut begins and carries a torque about the tip, ~markers shows the held nodes (`contact`)
 // while pressing, the surface gains cut faces, and two replays (with ~reset between) end in the
 // same mesh hash (latched std_msgs/String /tissue/mesh_hash). The achieved rate is printed.
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -147,9 +146,6 @@ TEST_F(Fixture, ReplayPressesThenCutsAndIsRepeatable) {
 }
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_bag_replay");
   ros::NodeHandle nh;

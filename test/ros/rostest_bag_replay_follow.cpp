@@ -7,7 +7,6 @@
 // cut is continuous across the moves), and every number the node published (~stats,
 // ~scalpel/wrench, ~surface, ~markers) is finite. Prints the stroke length, the moves, the cut
 // faces per centimetre and the time the replay took.
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -197,9 +196,6 @@ TEST_F(Fixture, StrokeLongerThanTheRegionCutsEndToEnd) {
 }
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_bag_replay_follow");
   ros::NodeHandle nh;

@@ -2,7 +2,6 @@
 // ~stats and /diagnostics keep coming; requests over the limits are refused with a message;
 // /diagnostics reports the worst step and the rate over the last second; a bad first pose
 // does not disable the scalpel (re-armed after ~pose_rearm_count jumps).
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -223,9 +222,6 @@ TEST_F(Fixture, BadFirstPoseIsRefusedAndJumpsReArm) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_live_node");
   ros::NodeHandle nh;

@@ -3,7 +3,6 @@
 // make_thigh_scene(), per-vertex colours, latched; plus the markers' namespaces.
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <gtest/gtest.h>
@@ -69,9 +68,6 @@ TEST(Surface, MarkerNamespaces) {
 }
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_surface");
   ros::NodeHandle nh;

@@ -7,7 +7,6 @@
 // blade pressed (in_contact, a wrench) and cut (cuts, tets split), the `scalpel` marker sits
 // where the pose put it in the tissue frame (to 1e-9 m), and the two nodes end in the same cut
 // (cut steps, tets split, tets, nodes): driving through tf is driving through the topic.
-#include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -157,9 +156,6 @@ TEST(TfScalpel, ARobotsToolFrameCutsLikeTheTopic) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The node's BLAS kernels (solve/blas_kernels.hpp): what this process computes with the
-  // core is compared with the node's output bit for bit.
-  stc::reexec_with_native_blas_kernels(argv);
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "rostest_tf_scalpel");
   ros::NodeHandle nh;
