@@ -1,5 +1,6 @@
 #include "cutting/cut_sweep.hpp"
 
+#include "cutting/earlier_triangles.hpp"
 #include "cutting/separation.hpp"
 #include "cutting/triangle_cut.hpp"
 
@@ -72,7 +73,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
       split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
                          border.p1, options, surface, result);
-  const std::vector<std::array<Vec3, 3>>& marks = corner_surface ? *corner_surface : surface;
+  StrokeSurface marks(corner_surface ? *corner_surface : surface);
   // The mesh no longer changes: every classification shares the nodes' scales.
   NodeScales scales;
   for (auto& tri : cut) {
@@ -82,44 +83,10 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     mark_faces_on_triangle(mesh, state, tri, a, b, options, marks, skin_slack, result, new_faces);
   }
   // Earlier triangles of the same stroke: a face that only now appears (this cut split the
-  // tets around it) may lie in any of them. Such a face belongs to a tet this cut touched,
-  // so look only among the cuttable tets inside those tets' box (one grid query for all).
-  if (!also_mark_in.empty() && !triangles.empty()) {
-    Vec3 touched_lo = lo, touched_hi = hi;
-    for (int t : state.grid.query(mesh, lo, hi)) {
-      Vec3 a, b;
-      tet_bounds(mesh, t, a, b);
-      touched_lo = touched_lo.cwiseMin(a);
-      touched_hi = touched_hi.cwiseMax(b);
-    }
-    struct Boxed {
-      int tet;
-      Vec3 lo, hi;
-    };
-    std::vector<Boxed> touched;
-    for (int t : cuttable_tets_in(mesh, state, touched_lo, touched_hi)) {
-      Boxed k{t, Vec3::Zero(), Vec3::Zero()};
-      tet_bounds(mesh, t, k.lo, k.hi);
-      touched.push_back(k);
-    }
-    std::vector<int> overlapping;
-    for (const auto& tri : also_mark_in) {
-      TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
-      if (previous.degenerate()) continue;
-      previous.share_scales(&scales);
-      Vec3 a, b;
-      previous.bounds(a, b);
-      a = a.cwiseMax(touched_lo);
-      b = b.cwiseMin(touched_hi);
-      if ((a.array() > b.array()).any()) continue;  // no overlap
-      overlapping.clear();
-      for (const Boxed& k : touched)
-        if ((k.lo.array() <= b.array()).all() && (a.array() <= k.hi.array()).all())
-          overlapping.push_back(k.tet);
-      mark_faces_on_triangle(mesh, state, previous, overlapping, options, marks, skin_slack, result,
-                             new_faces);
-    }
-  }
+  // tets around it) may lie in any of them.
+  if (!triangles.empty())
+    mark_faces_on_earlier_triangles(mesh, state, also_mark_in, lo, hi, options, marks, skin_slack,
+                                    scales, result, new_faces);
   if (!triangles.empty()) {
     // Marked faces lie inside the triangles' box; their tets overlap it.
     std::vector<int> region;

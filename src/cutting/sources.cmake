@@ -3,6 +3,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/cutting/blade_path.cpp
   src/cutting/cut_state.cpp
   src/cutting/cut_sweep.cpp
+  src/cutting/earlier_triangles.cpp
   src/cutting/edge_bisection.cpp
   src/cutting/free_pieces.cpp
   src/cutting/invariants.cpp

@@ -6,14 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace stc {
 namespace {
-
-// How far (in units of its longest edge) a face marked on the cut may lie off the stroke's
-// surface: its centroid off the triangle's plane, its corners off every triangle of the stroke.
-constexpr double kOnCutSlack = 0.25;
 
 // A crossing this near an end of its edge (a fraction of the edge) puts that end on the cut
 // as it is: it is not moved there.
@@ -188,6 +185,36 @@ double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
 }
 
 }  // namespace
+
+StrokeSurface::StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles)
+    : triangles_(triangles) {
+  for (const auto& s : triangles_) {
+    lo_.push_back(s[0].cwiseMin(s[1]).cwiseMin(s[2]));
+    hi_.push_back(s[0].cwiseMax(s[1]).cwiseMax(s[2]));
+  }
+}
+
+bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
+  auto [it, fresh] = known_.try_emplace(v, Known{});
+  Known& known = it->second;
+  if (slack >= known.near_at) return true;
+  if (slack <= known.far_below) return false;
+  // As near_surface: the first triangle within slack answers (nearest first).
+  const Vec3& x = mesh.nodes[v];
+  for (size_t i = 0; i < triangles_.size(); ++i) {
+    if ((x.array() < lo_[i].array() - slack).any() || (x.array() > hi_[i].array() + slack).any())
+      continue;
+    const auto& s = triangles_[i];
+    Vec3 w;
+    const double distance = (closest_point_on_triangle(x, s[0], s[1], s[2], w) - x).norm();
+    if (distance <= slack) {
+      known.near_at = std::min(known.near_at, distance);
+      return true;
+    }
+  }
+  known.far_below = std::max(known.far_below, slack);
+  return false;
+}
 
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi) {
@@ -506,88 +533,77 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
 
 void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri,
                             const Vec3& lo, const Vec3& hi, const CutOptions& options,
-                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
-                            CutResult& result, std::set<FaceKey>& new_faces) {
+                            StrokeSurface& surface, double skin_slack, CutResult& result,
+                            std::set<FaceKey>& new_faces) {
   if (tri.degenerate()) return;
-  mark_faces_on_triangle(mesh, state, tri, cuttable_tets_in(mesh, state, lo, hi), options, surface,
-                         skin_slack, result, new_faces);
+  for (int t : cuttable_tets_in(mesh, state, lo, hi)) {
+    // A tet with fewer than three corners on the cut has no face on it: checked once per tet
+    // (most tets around the blade), before any face.
+    const Tet& tet = mesh.tets[t];
+    int corners_on = 0;
+    for (int v : tet) corners_on += is_on_stroke(state, v) || tri.side(mesh, state, v) == 0;
+    if (corners_on < 3) continue;
+    for (int f = 0; f < 4; ++f)
+      mark_face_on_triangle(mesh, state, tri, t, f, options, surface, skin_slack, result,
+                            new_faces);
+  }
 }
 
-void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri,
-                            const std::vector<int>& tets, const CutOptions& options,
-                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
-                            CutResult& result, std::set<FaceKey>& new_faces) {
-  if (tri.degenerate()) return;
+void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& tri, int t,
+                           int f, const CutOptions& options, StrokeSurface& surface,
+                           double skin_slack, CutResult& result, std::set<FaceKey>& new_faces) {
   // (c) Faces on the cut: three "on" nodes, centroid inside the triangle, tets on opposite
   // sides. Both tets get the face's bit.
-  for (int t : tets) {
-    const Tet& tet = mesh.tets[t];
-    // Any node on the stroke's cut surface may be a corner: a face in the crease between two
-    // non-coplanar triangles of the stroke has corners on each; the checks below keep only
-    // faces that lie along this triangle. Each node's side at most once per tet, on demand (a
-    // node on the stroke is "on" whatever its side; a tet with fewer than three corners on the
-    // cut has no face on it).
-    constexpr int kUnknown = 2;
-    std::array<int, 4> sides = {kUnknown, kUnknown, kUnknown, kUnknown};
-    auto side_of = [&](int k) {
-      if (sides[k] == kUnknown) sides[k] = tri.side(mesh, state, tet[k]);
-      return sides[k];
-    };
-    std::array<bool, 4> on{};
-    int corners_on = 0;
-    for (int k = 0; k < 4; ++k) {
-      on[k] = is_on_stroke(state, tet[k]) || side_of(k) == 0;
-      corners_on += on[k];
-    }
-    if (corners_on < 3) continue;
-    for (int f = 0; f < 4; ++f) {
-      if (mesh.is_cut_face(t, f)) continue;
-      if (!on[kTetFaces[f][0]] || !on[kTetFaces[f][1]] || !on[kTetFaces[f][2]]) continue;
-      const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
-      // The geometric tests first: most faces of the stroke's surface lie along another of
-      // its triangles, and these reject them before the neighbour is looked up.
-      const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];
-      const Vec3 centroid = (xp + xq + xr) / 3.0;
-      if (!tri.contains(centroid, options.inside_tolerance)) continue;
-      // Nodes that came onto the cut in other sweeps of the stroke lie on it up to the snap
-      // rule: the face must lie along this triangle, near its plane and facing its way.
-      const Vec3 n = (xq - xp).cross(xr - xp);
-      const double longest = std::max({(xq - xp).norm(), (xr - xq).norm(), (xp - xr).norm()});
-      if (std::abs(tri.normal().dot(centroid - mesh.nodes[p]) + tri.distance(mesh, p)) >
-          kOnCutSlack * longest)
-        continue;
-      if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) continue;
-      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
-      if (other < 0) continue;
-      // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
-      // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
-      // it loose, separation keeps it attached, separation.cpp).
-      const int here = side_of(f);
-      const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
-      if (here != 0 && there != 0 && here == there) continue;
-      // Its corners too, on the stroke's surface up to the same slack: the centroid alone
-      // would open a face that reaches well past a border of the sweep.
-      const double slack = kOnCutSlack * longest;
-      // A corner on the tissue's boundary may lie skin_slack times farther: there the cut
-      // breaks through the skin, and the blade's edge carried to rest coordinates outside the
-      // tissue is extrapolated (rest_mapping.hpp), so the stroke's surface only approximates
-      // where the blade crossed the skin.
-      auto corner_ok = [&](int v, const Vec3& x) {
-        return near_surface(x, surface, slack) ||
-               (on_boundary(mesh, state, v) && near_surface(x, surface, skin_slack * slack));
-      };
-      if (!corner_ok(p, xp) || !corner_ok(q, xq) || !corner_ok(r, xr)) continue;
-      if (!state.cuttable[other]) {  // the blade stops at the condensed part
-        result.reached_interface = true;
-        continue;
-      }
-      mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
-      mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
-      FaceKey key = {p, q, r};
-      std::sort(key.begin(), key.end());
-      new_faces.insert(key);
-    }
+  if (mesh.is_cut_face(t, f)) return;
+  const Tet& tet = mesh.tets[t];
+  // Any node on the stroke's cut surface may be a corner: a face in the crease between two
+  // non-coplanar triangles of the stroke has corners on each; the checks below keep only
+  // faces that lie along this triangle (a node on the stroke is "on" whatever its side).
+  auto on = [&](int v) { return is_on_stroke(state, v) || tri.side(mesh, state, v) == 0; };
+  const int p = tet[kTetFaces[f][0]], q = tet[kTetFaces[f][1]], r = tet[kTetFaces[f][2]];
+  if (!on(p) || !on(q) || !on(r)) return;
+  // The geometric tests first: most faces of the stroke's surface lie along another of
+  // its triangles, and these reject them before the neighbour is looked up.
+  const Vec3 &xp = mesh.nodes[p], &xq = mesh.nodes[q], &xr = mesh.nodes[r];
+  const Vec3 centroid = (xp + xq + xr) / 3.0;
+  if (!tri.contains(centroid, options.inside_tolerance)) return;
+  // Nodes that came onto the cut in other sweeps of the stroke lie on it up to the snap
+  // rule: the face must lie along this triangle, near its plane and facing its way.
+  const Vec3 n = (xq - xp).cross(xr - xp);
+  const double longest = std::max({(xq - xp).norm(), (xr - xq).norm(), (xp - xr).norm()});
+  if (std::abs(tri.normal().dot(centroid - mesh.nodes[p]) + tri.distance(mesh, p)) >
+      kOnCutSlack * longest)
+    return;
+  if (!(std::abs(n.normalized().dot(tri.normal())) >= 0.5)) return;
+  const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+  if (other < 0) return;
+  // The two tets must not lie on one side of the cut (a fold of snapped nodes); a fourth
+  // vertex that is itself on the cut says nothing (a tet lying flat in the cut: if that cuts
+  // it loose, separation keeps it attached, separation.cpp).
+  const int here = tri.side(mesh, state, tet[f]);
+  const int there = tri.side(mesh, state, mesh.tets[other][other_face]);
+  if (here != 0 && there != 0 && here == there) return;
+  // Its corners too, on the stroke's surface up to the same slack: the centroid alone
+  // would open a face that reaches well past a border of the sweep.
+  const double slack = kOnCutSlack * longest;
+  // A corner on the tissue's boundary may lie skin_slack times farther: there the cut
+  // breaks through the skin, and the blade's edge carried to rest coordinates outside the
+  // tissue is extrapolated (rest_mapping.hpp), so the stroke's surface only approximates
+  // where the blade crossed the skin.
+  auto corner_ok = [&](int v) {
+    return surface.near_node(mesh, v, slack) ||
+           (on_boundary(mesh, state, v) && surface.near_node(mesh, v, skin_slack * slack));
+  };
+  if (!corner_ok(p) || !corner_ok(q) || !corner_ok(r)) return;
+  if (!state.cuttable[other]) {  // the blade stops at the condensed part
+    result.reached_interface = true;
+    return;
   }
+  mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
+  mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
+  FaceKey key = {p, q, r};
+  std::sort(key.begin(), key.end());
+  new_faces.insert(key);
 }
 
 }  // namespace stc

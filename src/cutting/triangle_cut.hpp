@@ -11,6 +11,7 @@
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
 
 #include <array>
+#include <limits>
 #include <set>
 #include <unordered_map>
 #include <vector>
@@ -57,6 +58,30 @@ class TriangleClassification {
   NodeScales* scales_ = nullptr;
 };
 
+// The stroke's surface as the mark phase tests a face's corners against it: its triangles
+// with their boxes, and what is known of each node's distance to them (the mark phase asks
+// about the same corners for every earlier triangle of a slow stroke; the mesh no longer
+// changes while it runs).
+class StrokeSurface {
+ public:
+  explicit StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles);
+  // Is node v within `slack` of one of the triangles?
+  bool near_node(const TetMesh& mesh, int v, double slack);
+
+ private:
+  std::vector<std::array<Vec3, 3>> triangles_;
+  std::vector<Vec3> lo_, hi_;
+  // A triangle within near_at (near for every slack >= it); none within far_below.
+  struct Known {
+    double near_at = std::numeric_limits<double>::infinity(), far_below = -1;
+  };
+  std::unordered_map<int, Known> known_;
+};
+
+// How far (in units of its longest edge) a face marked on the cut may lie off the stroke's
+// surface: its centroid off the triangle's plane, its corners off every triangle of the stroke.
+constexpr double kOnCutSlack = 0.25;
+
 // How much farther from the stroke's surface a face's corner on the tissue's boundary may lie
 // than an interior one while the blade sweeps (mark_faces_on_triangle). Without it a shallow
 // stroke along a sagging liver's top (every cut face has a skin corner) opened 71 % of its
@@ -87,7 +112,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
 
 // Phase 2. Marks interior faces between two cuttable tets with three "on" nodes, the tets'
 // fourth nodes on opposite sides and the centroid inside the triangle, among the tets that
-// overlap [lo, hi] (or among `tets`). Newly marked faces are added to `new_faces`.
+// overlap [lo, hi]. Newly marked faces are added to `new_faces`.
 // surface: every triangle of the stroke so far (this cut's and the earlier ones); a face is
 // marked only if its corners lie on it up to the snap distance, so no face reaching past the
 // blade's path opens (the centroid rule alone would open a face straddling a border).
@@ -95,12 +120,14 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
 // surface (kSkinCornerSlack while the blade sweeps; 1 at a stroke's end, finish_stroke).
 void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& triangle,
                             const Vec3& lo, const Vec3& hi, const CutOptions& options,
-                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
-                            CutResult& result, std::set<FaceKey>& new_faces);
-void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& triangle,
-                            const std::vector<int>& tets, const CutOptions& options,
-                            const std::vector<std::array<Vec3, 3>>& surface, double skin_slack,
-                            CutResult& result, std::set<FaceKey>& new_faces);
+                            StrokeSurface& surface, double skin_slack, CutResult& result,
+                            std::set<FaceKey>& new_faces);
+
+// Phase 2 for one face: local face f of tet t, by the tests above (whatever the tet's other
+// faces).
+void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& triangle,
+                           int t, int f, const CutOptions& options, StrokeSurface& surface,
+                           double skin_slack, CutResult& result, std::set<FaceKey>& new_faces);
 
 // The cuttable tets whose boxes overlap [lo, hi].
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,

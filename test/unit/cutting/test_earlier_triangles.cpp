@@ -1,0 +1,180 @@
+// The mark phase for a stroke's earlier triangles (cutting/earlier_triangles.hpp) marks exactly
+// what marking each triangle alone on the tets that overlap it marks (the straightforward
+// loop it replaced, kept here as the reference): same faces, same order of marking, same
+// interface flag. On the structured cube (whose grid nodes lie exactly on an axis plane: the
+// "on a plane, off the stroke" case; and at an interface with the condensed part) and on a
+// TetGen liver, with thin sweep-like triangles.
+#include "common/cut_fidelity_scenes.hpp"
+#include "cutting/earlier_triangles.hpp"
+#include "soft_tissue_cutting/generators/thigh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <functional>
+
+namespace stc {
+namespace {
+
+using Triangles = std::vector<std::array<Vec3, 3>>;
+
+// The reference: every earlier triangle in turn, on the cuttable tets (around the cut) whose
+// boxes overlap it; a tet's faces only if three of its corners are on the triangle.
+void reference_marks(TetMesh& mesh, const CutState& state, const Triangles& earlier, const Vec3& lo,
+                     const Vec3& hi, const CutOptions& options, StrokeSurface& surface,
+                     NodeScales& scales, CutResult& result, std::set<FaceKey>& new_faces) {
+  Vec3 touched_lo = lo, touched_hi = hi;
+  for (int t : state.grid.query(mesh, lo, hi)) {
+    Vec3 a, b;
+    tet_bounds(mesh, t, a, b);
+    touched_lo = touched_lo.cwiseMin(a);
+    touched_hi = touched_hi.cwiseMax(b);
+  }
+  const std::vector<int> touched = cuttable_tets_in(mesh, state, touched_lo, touched_hi);
+  for (const auto& tri : earlier) {
+    TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
+    if (previous.degenerate()) continue;
+    previous.share_scales(&scales);
+    Vec3 a, b;
+    previous.bounds(a, b);
+    a = a.cwiseMax(touched_lo);
+    b = b.cwiseMin(touched_hi);
+    if ((a.array() > b.array()).any()) continue;
+    for (int t : touched) {
+      Vec3 k_lo, k_hi;
+      tet_bounds(mesh, t, k_lo, k_hi);
+      if (!((k_lo.array() <= b.array()).all() && (a.array() <= k_hi.array()).all())) continue;
+      int on = 0;
+      for (int v : mesh.tets[t]) on += is_on_stroke(state, v) || previous.side(mesh, state, v) == 0;
+      if (on < 3) continue;
+      for (int f = 0; f < 4; ++f)
+        mark_face_on_triangle(mesh, state, previous, t, f, options, surface, kSkinCornerSlack,
+                              result, new_faces);
+    }
+  }
+}
+
+// A slow stroke's sweeps: the edge from `tip` to `heel` moved by `step`, `count` times; two
+// thin triangles per sweep.
+Triangles sweeps(const Vec3& tip, const Vec3& heel, const Vec3& step, int count) {
+  Triangles out;
+  for (int k = 0; k < count; ++k) {
+    const Vec3 a = tip + k * step, b = heel + k * step, c = tip + (k + 1) * step,
+               d = heel + (k + 1) * step;
+    out.push_back({a, b, c});
+    out.push_back({b, d, c});
+  }
+  return out;
+}
+
+struct Outcome {
+  std::vector<std::uint8_t> cut_faces;
+  std::set<FaceKey> faces;
+  bool reached_interface = false;
+  int off_stroke_corners = 0;  // corners of marked faces that are not on the stroke
+};
+
+// Splits the mesh along every triangle (as the stroke's sweeps did), then marks the faces on
+// them around the box [lo, hi] with `mark`.
+using Mark = std::function<void(TetMesh&, const CutState&, const Triangles&, const Vec3&,
+                                const Vec3&, const CutOptions&, StrokeSurface&, NodeScales&,
+                                CutResult&, std::set<FaceKey>&)>;
+Outcome split_then_mark(TetMesh mesh, std::vector<std::uint8_t> cuttable,
+                        const Triangles& triangles, const Vec3& lo, const Vec3& hi,
+                        const Mark& mark) {
+  CutState state = make_cut_state(mesh, {}, std::move(cuttable));
+  const CutOptions options;
+  CutResult result;
+  for (const auto& t : triangles) {
+    TriangleClassification c(t[0], t[1], t[2], options.snap_tolerance);
+    split_along_triangle(mesh, state, c, options, result);
+  }
+  StrokeSurface surface(triangles);
+  NodeScales scales;
+  Outcome out;
+  mark(mesh, state, triangles, lo, hi, options, surface, scales, result, out.faces);
+  out.cut_faces = mesh.cut_faces;
+  out.reached_interface = result.reached_interface;
+  for (const FaceKey& key : out.faces)
+    for (int v : key) out.off_stroke_corners += !is_on_stroke(state, v);
+  return out;
+}
+
+void expect_same_marks(const TetMesh& mesh, const std::vector<std::uint8_t>& cuttable,
+                       const Triangles& triangles, const Vec3& lo, const Vec3& hi,
+                       size_t at_least_faces, bool off_stroke_corners, bool at_interface = false) {
+  const Mark fast = [](TetMesh& m, const CutState& s, const Triangles& e, const Vec3& a,
+                       const Vec3& b, const CutOptions& o, StrokeSurface& surface,
+                       NodeScales& scales, CutResult& r, std::set<FaceKey>& faces) {
+    mark_faces_on_earlier_triangles(m, s, e, a, b, o, surface, kSkinCornerSlack, scales, r, faces);
+  };
+  const Outcome got = split_then_mark(mesh, cuttable, triangles, lo, hi, fast);
+  const Outcome want = split_then_mark(mesh, cuttable, triangles, lo, hi, reference_marks);
+  EXPECT_EQ(got.faces, want.faces)
+      << got.faces.size() << " faces marked, the reference " << want.faces.size();
+  EXPECT_TRUE(got.cut_faces == want.cut_faces) << "the tets' face bits differ";
+  EXPECT_EQ(got.reached_interface, want.reached_interface);
+  // Not vacuous: many faces marked, and (where asked) faces with corners off the stroke that
+  // are on the triangles' plane only (the cube's grid nodes).
+  EXPECT_GE(want.faces.size(), at_least_faces);
+  std::printf("earlier triangles: %zu faces marked (%d corners off the stroke), interface %d\n",
+              want.faces.size(), want.off_stroke_corners, int(want.reached_interface));
+  if (off_stroke_corners) {
+    EXPECT_GT(want.off_stroke_corners, 0);
+  }
+  EXPECT_EQ(want.reached_interface, at_interface);
+}
+
+TetMesh cube() {  // 4 cm, 1 cm cells: grid nodes on the planes z = 0, 0.01, ...
+  GeneratorParams g;
+  g.size = Vec3(0.04, 0.04, 0.04);
+  g.cells = {4, 4, 4};
+  return make_box_mesh(g);
+}
+
+TEST(EarlierTriangles, MarkWhatEachTriangleAloneMarksOnTheCubeThroughItsGridNodes) {
+  // A vertical stroke along x in the grid plane z = 0.02, 0.5 mm a sweep, the cut around
+  // all of it.
+  const Triangles t =
+      sweeps(Vec3(0.003, -0.001, 0.02), Vec3(0.003, 0.027, 0.02), Vec3(0.0005, 0, 0), 60);
+  expect_same_marks(cube(), {}, t, Vec3(0.003, 0, 0.019), Vec3(0.033, 0.027, 0.021), 10, true);
+}
+
+TEST(EarlierTriangles, MarkWhatEachTriangleAloneMarksOnATiltedCut) {
+  // A plane tilted about two axes, through no grid node.
+  const Vec3 tip(0.002, -0.001, 0.011), heel(0.002, 0.03, 0.019);
+  const Triangles t = sweeps(tip, heel, Vec3(0.0007, 0, 0.0002), 45);
+  expect_same_marks(cube(), {}, t, Vec3(0.0, 0, 0.0), Vec3(0.04, 0.03, 0.03), 5, false);
+}
+
+TEST(EarlierTriangles, ReportTheInterfaceAsEachTriangleAloneDoes) {
+  // The grid-plane stroke with the tets above z = 0.02 condensed (not cuttable): the faces on
+  // the plane lie between the two parts, where the blade stops.
+  const TetMesh mesh = cube();
+  std::vector<std::uint8_t> cuttable(mesh.tets.size(), 1);
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    Vec3 c = Vec3::Zero();
+    for (int v : mesh.tets[t]) c += mesh.nodes[v] / 4.0;
+    cuttable[t] = c.z() < 0.02;
+  }
+  const Triangles t =
+      sweeps(Vec3(0.003, -0.001, 0.02), Vec3(0.003, 0.027, 0.02), Vec3(0.0005, 0, 0), 60);
+  expect_same_marks(mesh, cuttable, t, Vec3(0.003, 0, 0.019), Vec3(0.033, 0.027, 0.021), 0, false,
+                    true);
+}
+
+TEST(EarlierTriangles, MarkWhatEachTriangleAloneMarksOnATetGenLiver) {
+  // The ~5k-tet TetGen liver (15 cm): a tilted blade drawn 6 cm through its middle,
+  // 0.4 mm a sweep, the cut around the last 2 cm.
+  const TetMesh mesh = fidelity::tetgen_liver("liver2", 5000);
+  Vec3 lo = mesh.nodes[0], hi = lo;
+  for (const Vec3& x : mesh.nodes) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  const Vec3 mid = (lo + hi) / 2;
+  const Vec3 tip = mid + Vec3(-0.04, -0.02, -0.004), heel = mid + Vec3(-0.04, 0.02, 0.006);
+  const Triangles t = sweeps(tip, heel, Vec3(0.0004, 0, 0.0001), 150);
+  const Vec3 end = tip + 150 * Vec3(0.0004, 0, 0.0001);
+  expect_same_marks(mesh, {}, t, end - Vec3(0.02, 0, 0.01), end + Vec3(0, 0.04, 0.02), 30, false);
+}
+
+}  // namespace
+}  // namespace stc
