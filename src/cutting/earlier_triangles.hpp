@@ -16,9 +16,9 @@ namespace stc {
 // own triangles (a face that only now appears belongs to a tet this cut touched; the tets
 // overlapping that box, and every cuttable tet inside their box, are looked at). The result is
 // that of mark_faces_on_triangle for each earlier triangle in turn on those of the tets whose
-// boxes overlap it; what does not depend on the triangle is found once, and only faces whose
-// corners are on it and whose centroid can pass its inside and plane tests (a box around the
-// triangle, docs/DESIGN.md section 8) are tested in full.
+// boxes overlap it, bit for bit; what does not depend on the triangle is found once, and only
+// faces whose corners may be on it and that pass necessary forms of its inside, plane and
+// facing tests (docs/DESIGN.md section 8, eq. (19b)) are tested in full.
 void mark_faces_on_earlier_triangles(TetMesh& mesh, const CutState& state,
                                      const std::vector<std::array<Vec3, 3>>& earlier,
                                      const Vec3& lo, const Vec3& hi, const CutOptions& options,
