@@ -152,7 +152,10 @@ class CpuCgSolver final : public LinearSolver {
     kept_index_.assign(kept_.empty() ? 0 : static_cast<size_t>(a_.rows()), -1);
     for (size_t i = 0; i < kept_.size(); ++i)
       kept_index_[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
-    kept_block_ = kept_.empty() ? SparseMatrix() : kept_block_of(a_);
+    if (kept_.empty())
+      kept_block_.resize(0, 0);
+    else
+      kept_block_of(a_, kept_block_);
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -353,11 +356,13 @@ class CpuCgSolver final : public LinearSolver {
   const SparseMatrix& block() const { return kept_.empty() ? a_ : kept_block_; }
 
   // A_kk of `a` (kept_ set).
-  SparseMatrix kept_block_of(const SparseMatrix& a) const {
+  // Written into `out`, whose arrays (the block before last, swapped out in set_matrix) are
+  // re-used: a new matrix every cut page-faulted in megabytes of fresh memory each time.
+  void kept_block_of(const SparseMatrix& a, SparseMatrix& out) const {
     // Row by row in kept order: the renumbering is increasing, so each row's columns stay
     // sorted and the compressed arrays are written directly (no triplets, no sort).
     const auto n = static_cast<Eigen::Index>(kept_.size());
-    SparseMatrix out(n, n);
+    out.resize(n, n);
     out.reserve(a.nonZeros());
     for (Eigen::Index i = 0; i < n; ++i) {
       out.startVec(i);
@@ -367,7 +372,6 @@ class CpuCgSolver final : public LinearSolver {
       }
     }
     out.finalize();
-    return out;
   }
 
   // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
