@@ -68,11 +68,12 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   // All splits first, then all marks (triangle_cut.hpp says why).
   // The stroke's surface, nearest first (a face's corners are looked for in this order).
   const Triangles surface = nearest_first(triangles, also_mark_in);
+  const StrokeSurface stroke(surface);
   for (auto& tri : cut) split_along_triangle(mesh, state, tri, options, result);
   for (const CutBorder& border : borders)
     if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
       split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
-                         border.p1, options, surface, result);
+                         border.p1, options, stroke, result);
   StrokeSurface marks(corner_surface ? *corner_surface : surface);
   // The mesh no longer changes: every classification shares the nodes' scales.
   NodeScales scales;

@@ -71,22 +71,26 @@ struct CandidateFaces {
 
 }  // namespace
 
+std::vector<int> tets_around_cut(const TetMesh& mesh, const CutState& state, Vec3& lo, Vec3& hi) {
+  const Vec3 cut_lo = lo, cut_hi = hi;
+  for (int t : state.grid.query(mesh, cut_lo, cut_hi)) {
+    Vec3 a, b;
+    tet_bounds(mesh, t, a, b);
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+  }
+  return cuttable_tets_in(mesh, state, lo, hi);
+}
+
 void mark_faces_on_earlier_triangles(TetMesh& mesh, const CutState& state,
                                      const std::vector<std::array<Vec3, 3>>& earlier,
                                      const Vec3& lo, const Vec3& hi, const CutOptions& options,
                                      StrokeSurface& surface, double skin_slack, NodeScales& scales,
                                      CutResult& result, std::set<FaceKey>& new_faces) {
   if (earlier.empty()) return;
-  // The tets this cut touched overlap [lo, hi]; every cuttable tet inside their box is looked
-  // at (one grid query for all).
+  // The tets this cut touched overlap [lo, hi]: a face that only now appears is among them.
   Vec3 touched_lo = lo, touched_hi = hi;
-  for (int t : state.grid.query(mesh, lo, hi)) {
-    Vec3 a, b;
-    tet_bounds(mesh, t, a, b);
-    touched_lo = touched_lo.cwiseMin(a);
-    touched_hi = touched_hi.cwiseMax(b);
-  }
-  const std::vector<int> tets = cuttable_tets_in(mesh, state, touched_lo, touched_hi);
+  const std::vector<int> tets = tets_around_cut(mesh, state, touched_lo, touched_hi);
   std::vector<Vec3> box_lo(tets.size()), box_hi(tets.size());
   for (size_t i = 0; i < tets.size(); ++i) tet_bounds(mesh, tets[i], box_lo[i], box_hi[i]);
 

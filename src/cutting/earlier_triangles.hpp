@@ -19,6 +19,11 @@ namespace stc {
 // boxes overlap it, bit for bit; what does not depend on the triangle is found once, and only
 // faces whose corners may be on it and that pass necessary forms of its inside, plane and
 // facing tests (docs/DESIGN.md section 8, eq. (19b)) are tested in full.
+// The cuttable tets around a cut whose own triangles lie in the box [lo, hi]: those overlapping
+// it and every cuttable tet inside their box (one grid query for all), ascending. lo and hi
+// become that box.
+std::vector<int> tets_around_cut(const TetMesh& mesh, const CutState& state, Vec3& lo, Vec3& hi);
+
 void mark_faces_on_earlier_triangles(TetMesh& mesh, const CutState& state,
                                      const std::vector<std::array<Vec3, 3>>& earlier,
                                      const Vec3& lo, const Vec3& hi, const CutOptions& options,

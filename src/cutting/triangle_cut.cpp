@@ -16,18 +16,6 @@ namespace {
 // as it is: it is not moved there.
 constexpr double kNegligibleMove = 1e-3;
 
-// Is x within `slack` of one of the stroke's triangles?
-bool near_surface(const Vec3& x, const std::vector<std::array<Vec3, 3>>& surface, double slack) {
-  for (const auto& s : surface) {
-    const Vec3 lo = s[0].cwiseMin(s[1]).cwiseMin(s[2]).array() - slack,
-               hi = s[0].cwiseMax(s[1]).cwiseMax(s[2]).array() + slack;
-    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
-    Vec3 w;
-    if ((closest_point_on_triangle(x, s[0], s[1], s[2], w) - x).norm() <= slack) return true;
-  }
-  return false;
-}
-
 // Is the stroke's surface flat where it meets the box [lo, hi]: every triangle of it there
 // within 10 deg of `normal`? (A straight stroke's is; a curved, tilted one's turns.)
 bool flat_within(const std::vector<std::array<Vec3, 3>>& surface, const Vec3& normal,
@@ -194,23 +182,26 @@ StrokeSurface::StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles)
   }
 }
 
-bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
-  auto [it, fresh] = known_.try_emplace(v, Known{});
-  Known& known = it->second;
-  if (slack >= known.near_at) return true;
-  if (slack <= known.far_below) return false;
-  // As near_surface: the first triangle within slack answers (nearest first).
-  const Vec3& x = mesh.nodes[v];
+double StrokeSurface::first_within(const Vec3& x, double slack) const {
   for (size_t i = 0; i < triangles_.size(); ++i) {
     if ((x.array() < lo_[i].array() - slack).any() || (x.array() > hi_[i].array() + slack).any())
       continue;
     const auto& s = triangles_[i];
     Vec3 w;
     const double distance = (closest_point_on_triangle(x, s[0], s[1], s[2], w) - x).norm();
-    if (distance <= slack) {
-      known.near_at = std::min(known.near_at, distance);
-      return true;
-    }
+    if (distance <= slack) return distance;
+  }
+  return -1;
+}
+
+bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
+  auto [it, fresh] = known_.try_emplace(v, Known{});
+  Known& known = it->second;
+  if (slack >= known.near_at) return true;
+  if (slack <= known.far_below) return false;
+  if (const double distance = first_within(mesh.nodes[v], slack); distance >= 0) {
+    known.near_at = std::min(known.near_at, distance);
+    return true;
   }
   known.far_below = std::max(known.far_below, slack);
   return false;
@@ -406,8 +397,8 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 }
 
 void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& tri, const Vec3& p0,
-                        const Vec3& p1, const CutOptions& options,
-                        const std::vector<std::array<Vec3, 3>>& surface, CutResult& result) {
+                        const Vec3& p1, const CutOptions& options, const StrokeSurface& surface,
+                        CutResult& result) {
   if (tri.degenerate()) return;
   const Vec3 along = p1 - p0;
   const double length2 = along.squaredNorm();
@@ -452,8 +443,8 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
       outside = outside || d > on_line;
       beside = beside || along_segment(x);
       if (d * sweep_side > 0 && on_surface)
-        on_surface = near_surface(x, surface, kOnCutSlack * longest) ||
-                     flat_within(surface, tri.normal(), tet_lo, tet_hi);
+        on_surface = surface.near(x, kOnCutSlack * longest) ||
+                     flat_within(surface.triangles(), tri.normal(), tet_lo, tet_hi);
     }
     if (inside && outside && beside && on_surface) whole.push_back(t);
   }

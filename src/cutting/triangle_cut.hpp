@@ -65,10 +65,16 @@ class TriangleClassification {
 class StrokeSurface {
  public:
   explicit StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles);
-  // Is node v within `slack` of one of the triangles?
+  const std::vector<std::array<Vec3, 3>>& triangles() const { return triangles_; }
+  // Is x within `slack` of one of the triangles?
+  bool near(const Vec3& x, double slack) const { return first_within(x, slack) >= 0; }
+  // The same for node v, from what is known of it where that answers (mark phase only).
   bool near_node(const TetMesh& mesh, int v, double slack);
 
  private:
+  // The distance to the first triangle (in order: nearest first) within slack, or -1.
+  double first_within(const Vec3& x, double slack) const;
+
   std::vector<std::array<Vec3, 3>> triangles_;
   std::vector<Vec3> lo_, hi_;
   // A triangle within near_at (near for every slack >= it); none within far_below.
@@ -108,7 +114,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 // triangle's plane across a large tet; a straight one's may just end inside it).
 void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& triangle,
                         const Vec3& p0, const Vec3& p1, const CutOptions& options,
-                        const std::vector<std::array<Vec3, 3>>& surface, CutResult& result);
+                        const StrokeSurface& surface, CutResult& result);
 
 // Phase 2. Marks interior faces between two cuttable tets with three "on" nodes, the tets'
 // fourth nodes on opposite sides and the centroid inside the triangle, among the tets that

@@ -23,14 +23,8 @@ using Triangles = std::vector<std::array<Vec3, 3>>;
 void reference_marks(TetMesh& mesh, const CutState& state, const Triangles& earlier, const Vec3& lo,
                      const Vec3& hi, const CutOptions& options, StrokeSurface& surface,
                      NodeScales& scales, CutResult& result, std::set<FaceKey>& new_faces) {
-  Vec3 touched_lo = lo, touched_hi = hi;
-  for (int t : state.grid.query(mesh, lo, hi)) {
-    Vec3 a, b;
-    tet_bounds(mesh, t, a, b);
-    touched_lo = touched_lo.cwiseMin(a);
-    touched_hi = touched_hi.cwiseMax(b);
-  }
-  const std::vector<int> touched = cuttable_tets_in(mesh, state, touched_lo, touched_hi);
+  Vec3 touched_lo = lo, touched_hi = hi;  // the same tets around the cut
+  const std::vector<int> touched = tets_around_cut(mesh, state, touched_lo, touched_hi);
   for (const auto& tri : earlier) {
     TriangleClassification previous(tri[0], tri[1], tri[2], options.snap_tolerance);
     if (previous.degenerate()) continue;
