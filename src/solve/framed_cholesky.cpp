@@ -74,11 +74,8 @@ struct Extra {
   std::vector<int> rows;       // X, in the order of S's trailing block
   std::vector<int> positions;  // their places in the elimination order (< n_f)
   Eigen::MatrixXd y;           // Y = L_FF^-1 E_X                        (n_f x |X|)
-  Eigen::MatrixXd z;           // Z = G E_X = L_FF^-T Y                  (n_f x |X|)
   Eigen::MatrixXd m;           // M = L_FF^-1 A_FX                       (n_f x |X|)
   Eigen::MatrixXd q;           // Q = L_BF Y                             (|B| x |X|)
-  Eigen::MatrixXd a_xb;        // A_XB of the factored matrix            (|X| x |B|)
-  Eigen::MatrixXd a_xx;        // A_XX of the factored matrix            (|X| x |X|)
   Eigen::MatrixXd t;           // T_XX = (Y^T Y)^-1                      (|X| x |X|)
   Eigen::MatrixXd w;           // W'' over [B, X] (eq. (28)), lower triangle
   bool empty() const { return rows.empty(); }
@@ -138,27 +135,50 @@ struct FramedCholesky::Impl {
     return out;
   }
 
+  // Rows `positions` (< n_f) of L_FF, transposed: n_f x |positions|. They are M = L_FF^-1 A_FX
+  // for those rows X (A_FX = A_FF E_X = L_FF L_FF^T E_X), read from the supernodes' row lists
+  // instead of solved for.
+  Eigen::MatrixXd l_rows_transposed(const std::vector<int>& positions) const {
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_f, static_cast<Eigen::Index>(positions.size()));
+    std::vector<int> column_of(position.size(), -1);
+    for (size_t j = 0; j < positions.size(); ++j)
+      column_of[static_cast<size_t>(positions[j])] = static_cast<int>(j);
+    const auto* super = static_cast<const int*>(factor->super);
+    const auto* pi = static_cast<const int*>(factor->pi);
+    const auto* px = static_cast<const int*>(factor->px);
+    const auto* ls = static_cast<const int*>(factor->s);
+    const auto* lx = static_cast<const double*>(factor->x);
+    for (size_t sn = 0; sn < factor->nsuper && super[sn] < n_f; ++sn) {
+      const int nrows = pi[sn + 1] - pi[sn], last = std::min(super[sn + 1], n_f);
+      for (int ii = 0; ii < nrows; ++ii) {
+        const int row = ls[pi[sn] + ii];
+        const int j =
+            row < static_cast<int>(column_of.size()) ? column_of[static_cast<size_t>(row)] : -1;
+        if (j < 0) continue;
+        for (int c = super[sn]; c < last && c <= row; ++c)  // the lower part: column <= row
+          out(c, j) = lx[px[sn] + static_cast<ptrdiff_t>(c - super[sn]) * nrows + ii];
+      }
+    }
+    return out;
+  }
+
   // `from` with the rows `added` of F moved into the frame as well (eq. (28)): their columns
-  // of Y, Z, M and Q by one forward solve of 2|added| columns and one backward solve of
-  // |added|, then T_XX and W'' anew (dense, |X| small). Rows of A are the factored matrix's.
+  // of Y and Q by one forward solve of |added| columns, of M from L's rows, then T_XX and W''
+  // anew (dense, |X| small). Rows of A are the factored matrix's.
   std::optional<Extra> extended(const Extra& from, const std::vector<int>& added) const {
     const int n_old = static_cast<int>(factored.rows()), nb = n_old - n_f;
     const int k = static_cast<int>(added.size()), k0 = static_cast<int>(from.rows.size());
     Extra x = from;
     x.rows.insert(x.rows.end(), added.begin(), added.end());
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_old, 2 * k);
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_old, k);
+    std::vector<int> added_positions;
     for (int j = 0; j < k; ++j) {
-      const int r = added[static_cast<size_t>(j)];
-      x.positions.push_back(position[static_cast<size_t>(r)]);
-      rhs(position[static_cast<size_t>(r)], j) = 1.0;
-      for (SparseMatrix::InnerIterator it(factored, r); it; ++it)  // A_FX: row r, symmetric
-        if (const int p = position[static_cast<size_t>(it.index())]; p < n_f)
-          rhs(p, k + j) = it.value();
+      const int p = position[static_cast<size_t>(added[static_cast<size_t>(j)])];
+      x.positions.push_back(p);
+      added_positions.push_back(p);
+      rhs(p, j) = 1.0;
     }
     const Eigen::MatrixXd l = triangular_solve(CHOLMOD_L, rhs);
-    Eigen::MatrixXd back = Eigen::MatrixXd::Zero(n_old, k);
-    back.topRows(n_f) = l.topLeftCorner(n_f, k);
-    const Eigen::MatrixXd lt = triangular_solve(CHOLMOD_Lt, back);
     // L^-1 [E_X; 0] = [Y; -L_BB^-1 L_BF Y], so Q = L_BF Y = -L_BB times its frame rows.
     Eigen::MatrixXd q = -l.bottomLeftCorner(nb, k);
     {
@@ -172,20 +192,18 @@ struct FramedCholesky::Impl {
       to = std::move(out);
     };
     append(x.y, l.topLeftCorner(n_f, k));
-    append(x.m, l.topRightCorner(n_f, k));
-    append(x.z, lt.topRows(n_f));
+    append(x.m, l_rows_transposed(added_positions));
     append(x.q, q);
     const int nx = k0 + k;
-    x.a_xb = Eigen::MatrixXd::Zero(nx, nb);
-    x.a_xx = Eigen::MatrixXd::Zero(nx, nx);
+    Eigen::MatrixXd a_xb = Eigen::MatrixXd::Zero(nx, nb);  // of the factored matrix
+    Eigen::MatrixXd a_xx = Eigen::MatrixXd::Zero(nx, nx);
     std::vector<int> in_x(static_cast<size_t>(n_old), -1);
     for (int j = 0; j < nx; ++j) in_x[static_cast<size_t>(x.rows[static_cast<size_t>(j)])] = j;
     for (int j = 0; j < nx; ++j)
       for (SparseMatrix::InnerIterator it(factored, x.rows[static_cast<size_t>(j)]); it; ++it) {
         const int c = static_cast<int>(it.index());
-        if (const int p = position[static_cast<size_t>(c)]; p >= n_f)
-          x.a_xb(j, p - n_f) = it.value();
-        if (const int i = in_x[static_cast<size_t>(c)]; i >= 0) x.a_xx(j, i) = it.value();
+        if (const int p = position[static_cast<size_t>(c)]; p >= n_f) a_xb(j, p - n_f) = it.value();
+        if (const int i = in_x[static_cast<size_t>(c)]; i >= 0) a_xx(j, i) = it.value();
       }
     // T_XX = (Y^T Y)^-1 = ((A_FF^-1)_XX)^-1, the Schur complement of A_F'F' onto X.
     const Eigen::LLT<Eigen::MatrixXd> g(x.y.transpose() * x.y);
@@ -196,8 +214,8 @@ struct FramedCholesky::Impl {
     x.w.resize(nb + nx, nb + nx);
     x.w.topLeftCorner(nb, nb) = w.selfadjointView<Eigen::Lower>();
     x.w.topLeftCorner(nb, nb).noalias() -= x.q * tq;
-    x.w.bottomRightCorner(nx, nx) = x.a_xx - x.t;
-    x.w.bottomLeftCorner(nx, nb) = x.a_xb - tq;
+    x.w.bottomRightCorner(nx, nx) = a_xx - x.t;
+    x.w.bottomLeftCorner(nx, nb) = a_xb - tq;
     return x;
   }
 };
@@ -302,7 +320,7 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
 
 FramedCholesky::~FramedCholesky() = default;
 
-bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* changed) {
+bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* changed, int max_frame) {
   Impl& m = *impl_;
   const int n_old = static_cast<int>(m.factored.rows());
   const int n = static_cast<int>(a.rows());
@@ -322,6 +340,11 @@ bool FramedCholesky::update(const SparseMatrix& a, const std::vector<int>* chang
   std::sort(outside.begin(), outside.end());
   outside.erase(std::unique(outside.begin(), outside.end()), outside.end());
   if (static_cast<int>(m.extra.rows.size() + outside.size()) > kMaxExtraRows) return false;
+  // The frame it would make: the old one, the new DOFs, the extra rows (below).
+  if (static_cast<long>(n_old - m.n_f) + (n - n_old) + static_cast<long>(outside.size()) +
+          static_cast<long>(m.extra.rows.size()) >
+      max_frame)
+    return false;
   std::optional<Extra> extra;
   if (!outside.empty()) {
     extra = m.extended(m.extra, outside);
@@ -386,7 +409,7 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
   }
   // Eq. (27): z = L^-1 P b with the kept factor; its frame rows give r_B = b_B - L_BF z_F.
   // Extra rows X (eq. (29)): their entries of b are left out of z and enter the frame's solve
-  // with T_XX Y^T z_F; the back substitution then solves with A_F'F' through G and Z.
+  // with T_XX Y^T z_F; the back substitution then solves with A_F'F'.
   const Extra& ex = m.extra;
   const int nx = static_cast<int>(ex.rows.size());
   Eigen::MatrixXd bp(n_old, cols);
@@ -411,23 +434,21 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
     x_b.topRows(nb_old) = r_old;
     cholesky_solve(m.schur, x_b);
     // Back: L^T x_p = [z_F; L_BB^T x_B] returns x_B in its frame rows and x_F above them.
-    if (nx > 0) z.topRows(m.n_f).noalias() -= ex.m * x_b.bottomRows(nx);
     Eigen::MatrixXd top = x_b.topRows(nb_old);
     lower_times(m.l_bb, true, top);
     z.bottomRows(nb_old) = top;
+    if (nx > 0) {
+      // Eq. (29): z_F - M x_X substituted back would solve with all of A_FF and give rows g_X
+      // on X; g_X = Y^T z_F - Q^T x_B is known before it (E_X^T L_FF^-T = Y^T; the
+      // substitution's frame rows are x_B), and taking Y T_XX g_X out of z_F zeroes them and
+      // leaves F' solved with A_F'F'.
+      auto z_f = z.topRows(m.n_f);
+      z_f.noalias() -= ex.m * x_b.bottomRows(nx);
+      const Eigen::MatrixXd g_x = ex.y.transpose() * z_f - ex.q.transpose() * x_b.topRows(nb_old);
+      z_f.noalias() -= ex.y * (ex.t * g_x);
+    }
   }
-  Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
-  if (nx > 0) {
-    // xp_F = G v~ with v~ = b_F - A_FX x_X - A_FB x_B; its X rows, -(A_XX x_X + A_XB x_B), are
-    // taken out (G E_X = Z), then the solution's X rows zeroed: u = g - Z T_XX g_X.
-    const Eigen::MatrixXd x_x = x_b.bottomRows(nx);
-    const Eigen::MatrixXd v_x = -(ex.a_xx * x_x + ex.a_xb * x_b.topRows(nb_old));
-    auto g = xp.topRows(m.n_f);
-    g.noalias() -= ex.z * v_x;
-    Eigen::MatrixXd g_x(nx, cols);
-    for (int j = 0; j < nx; ++j) g_x.row(j) = g.row(ex.positions[static_cast<size_t>(j)]);
-    g.noalias() -= ex.z * (ex.t * g_x);
-  }
+  const Eigen::MatrixXd xp = m.triangular_solve(CHOLMOD_Lt, z);
   Eigen::MatrixXd x(rows_, cols);
   for (int k = 0; k < m.n_f; ++k) x.row(m.perm[static_cast<size_t>(k)]) = xp.row(k);
   for (int j = 0; j < nb; ++j) x.row(frame_[static_cast<size_t>(j)]) = x_b.row(j);

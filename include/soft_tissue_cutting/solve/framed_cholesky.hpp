@@ -17,13 +17,14 @@
 // rounding of a direct solve. A later change that reaches a few rows X of F (the blade's next
 // cut one ring past the frame) moves them into the frame without a refactorization: the
 // Schur complement of A_F'F' (F' = F \ X) onto X u B follows from L's solves with X's unit
-// columns, eq. (28), and the solves correct G = A_FF^-1 for X, eq. (29).
+// columns, eq. (28), and a solve takes X's rows out of its one backward substitution, eq. (29).
 #pragma once
 
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -50,8 +51,10 @@ class FramedCholesky final : public CholeskySolve {
   // frame's Schur complement is positive definite. Rows beyond rows() are new DOFs and join the
   // frame. Returns false, leaving this factor as it was, otherwise.
   // `changed`, when given, lists every row in which `a` may differ from the factored matrix
-  // (the others are taken as equal, not compared).
-  bool update(const SparseMatrix& a, const std::vector<int>* changed = nullptr);
+  // (the others are taken as equal, not compared). A frame that would grow past `max_frame`
+  // rows is refused before any work on it (the caller refactors instead).
+  bool update(const SparseMatrix& a, const std::vector<int>* changed = nullptr,
+              int max_frame = std::numeric_limits<int>::max());
 
   Vector solve(const Vector& b) const override;
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const override;
