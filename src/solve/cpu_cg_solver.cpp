@@ -42,11 +42,13 @@
 #include "soft_tissue_cutting/solve/held_dof_solve.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
+#include "solve/blas_guard.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -85,9 +87,16 @@ constexpr double kShift = 1e-9;
 // refactorization frames the latest changes afresh. The organ liver's follow stroke (offline,
 // 172 cuts, with eq. (28)): frames kept up to the whole cap, 16 refactorizations and 3.5 GFlop
 // in frame updates; up to 0.75 of it, 19 and 2.5 GFlop; 0.63, 32 and 1.6 GFlop.
+// A frame past kPrefactorShare of the cap is refactored ahead, on a second thread, around the
+// cut that grew it (docs/DESIGN.md section 6.2, "Refactored ahead"): the next cut updates that
+// factor's fresh frame instead of this grown one, so a frame rarely reaches kUpdateFrameShare
+// and its full refactorization on the loop's thread (~20 ms on the organ liver, the cutting
+// step's maximum). Organ liver, the online follow stroke, three runs each: cutting steps'
+// solve median 5.0-6.1 -> 4.1-4.8 ms at 0.65 (0.5: 4.2-5.6, with more threads started).
 constexpr int kFrameRings = 2;
 constexpr double kWiderFrameShare = 0.6;
 constexpr double kUpdateFrameShare = 0.75;
+constexpr double kPrefactorShare = 0.65;
 constexpr int kMinFrame = 600;
 constexpr int kMaxFrame = 1200;
 int max_frame(Eigen::Index rows, double refactor_flops) {
@@ -104,6 +113,7 @@ std::string format_residual(double r) {
 class CpuCgSolver final : public LinearSolver {
  public:
   explicit CpuCgSolver(CgPreconditioner wanted) : wanted_(wanted) {}
+  ~CpuCgSolver() override { take_prefactor(); }  // the thread reads this solver's block
 
   std::string backend() const override { return "cpu"; }
   std::string preconditioner() const override { return active_; }
@@ -129,6 +139,8 @@ class CpuCgSolver final : public LinearSolver {
   void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                   const History& history) override {
     const auto t0 = std::chrono::steady_clock::now();
+    // The factor refactored ahead, of the last block (before that block is swapped away).
+    std::unique_ptr<FramedCholesky> ahead = take_prefactor();
     const Vector old_held_mask = held_mask_;
     const Eigen::Index old_rows = a_.rows();
     // The last factored block, kept (what the next frame is chosen against): swapped, not
@@ -185,7 +197,7 @@ class CpuCgSolver final : public LinearSolver {
     if (same_rows && history.changed_rows) changed = block_rows(*history.changed_rows);
     if (history.expected_rows) expected = block_rows(*history.expected_rows);
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.interface_rows, previous, changed, expected);
+      factor(same_rows, history.interface_rows, previous, changed, expected, std::move(ahead));
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -379,13 +391,29 @@ class CpuCgSolver final : public LinearSolver {
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
   // keeps a frame around what changed since `previous` (the last block); its first `interface`
   // rows are the dense interface block.
+  // ahead: the last block's factor refactored ahead (kPrefactorShare), if one was.
   void factor(bool same_rows, int interface, const SparseMatrix& previous,
               const std::optional<std::vector<int>>& changed,
-              const std::optional<std::vector<int>>& expected) {
+              const std::optional<std::vector<int>>& expected,
+              std::unique_ptr<FramedCholesky> ahead) {
     const SparseMatrix& block = this->block();
     if (block.rows() == 0) {
       chol_.reset();
       active_ = "jacobi";
+      return;
+    }
+    int dense = interface;  // the interface block's rows in the block's numbering
+    if (!kept_.empty())
+      dense =
+          static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) - kept_.begin());
+    // The factor refactored ahead differs from this block in this change's rows alone.
+    if (ahead && same_rows && changed && active_ == "cholesky" &&
+        ahead->update(
+            block, &*changed,
+            static_cast<int>(kUpdateFrameShare * max_frame(block.rows(), ahead->factor_flops())))) {
+      chol_ = std::move(ahead);
+      changed_since_factor_ = *changed;
+      ++frame_updates_;
       return;
     }
     // Every row changed since the factorization: this change's, and the earlier updates'.
@@ -393,31 +421,24 @@ class CpuCgSolver final : public LinearSolver {
       changed_since_factor_->insert(changed_since_factor_->end(), changed->begin(), changed->end());
     else
       changed_since_factor_.reset();
-    if (same_rows && active_ == "cholesky" &&
-        chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr)) {
-      if (chol_->frame_size() <=
-          kUpdateFrameShare * max_frame(block.rows(), chol_->factor_flops())) {
+    if (same_rows && active_ == "cholesky") {
+      const int cap = max_frame(block.rows(), chol_->factor_flops());
+      if (chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr,
+                        static_cast<int>(kUpdateFrameShare * cap))) {
         ++frame_updates_;
+        if (changed && chol_->frame_size() > kPrefactorShare * cap)
+          prefactor(frame_for(block, previous, changed, dense, cap));
         return;
       }
     }
     // The last factorization's cost stands for this one's (the block changed by one cut).
     const double refactor_flops = chol_ ? chol_->factor_flops() : 0;
-    std::vector<int> frame;
-    int dense = interface;
-    if (!kept_.empty())
-      dense =
-          static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) - kept_.begin());
     const int cap = max_frame(block.rows(), refactor_flops);
-    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows()) {
-      for (int rings = kFrameRings; rings >= 1; --rings) {  // fewer rings where more pass the cap
-        frame = changed ? FramedCholesky::frame_around(block, *changed, dense, rings)
-                        : FramedCholesky::frame_around_changes(previous, block, dense, rings);
-        if (frame.size() <= (rings > 1 ? kWiderFrameShare : 1.0) * cap) break;
-      }
-    } else if (expected && !expected->empty()) {  // a fresh factor: frame where a cut is expected
+    std::vector<int> frame;
+    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows())
+      frame = frame_for(block, previous, changed, dense, cap);
+    else if (expected && !expected->empty())  // a fresh factor: frame where a cut is expected
       frame = FramedCholesky::frame_around(block, *expected, dense, 1);
-    }
     if (static_cast<int>(frame.size()) > cap) frame.clear();
     chol_.reset();
     active_ = "jacobi";
@@ -443,10 +464,49 @@ class CpuCgSolver final : public LinearSolver {
     }
   }
 
+  // The frame a factorization after a change keeps: the rows changed since `previous` (this
+  // change's, when known) and kFrameRings rings of neighbours, fewer where more would pass
+  // kWiderFrameShare of the cap. `dense`: the interface block's rows (never grow it).
+  static std::vector<int> frame_for(const SparseMatrix& block, const SparseMatrix& previous,
+                                    const std::optional<std::vector<int>>& changed, int dense,
+                                    int cap) {
+    std::vector<int> frame;
+    for (int rings = kFrameRings; rings >= 1; --rings) {
+      frame = changed ? FramedCholesky::frame_around(block, *changed, dense, rings)
+                      : FramedCholesky::frame_around_changes(previous, block, dense, rings);
+      if (frame.size() <= (rings > 1 ? kWiderFrameShare : 1.0) * cap) break;
+    }
+    return frame;
+  }
+
+  // Refactors the present block with `frame` on a second thread (it reads block() until
+  // take_prefactor, which the next set_matrix calls first).
+  void prefactor(std::vector<int> frame) {
+    if (frame.empty()) return;
+    const SparseMatrix& block = this->block();
+    prefactor_ = std::async(std::launch::async, [&block, frame = std::move(frame)]() {
+      settle_openmp_on_this_thread();  // CHOLMOD at full speed on this thread (blas_guard.hpp)
+      std::unique_ptr<FramedCholesky> f;
+      try {
+        f = std::make_unique<FramedCholesky>(block, frame);
+      } catch (const std::runtime_error&) {  // not positive definite: the loop's path will say
+      }
+      return f;
+    });
+  }
+
+  // The factor refactored ahead, waiting for it (null if none was started or it failed): one
+  // taken at every set_matrix, so which factor a step uses never depends on timing.
+  std::unique_ptr<FramedCholesky> take_prefactor() {
+    if (!prefactor_.valid()) return nullptr;
+    return prefactor_.get();
+  }
+
   CgPreconditioner wanted_;
   SparseMatrix a_;
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
+  std::future<std::unique_ptr<FramedCholesky>> prefactor_;  // the block's, refactored ahead
   SparseMatrix kept_block_;  // A_kk when some DOFs are held (else the block is a_ itself)
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
