@@ -349,8 +349,9 @@ struct Simulation::Impl {
     const int held_before = free_pieces_held;
     hold_free_pieces();
     if (free_pieces_held > held_before) {
-      // The held DOFs leave the factor, so its rows change and the next factorization cannot
-      // frame this cut's changes: it frames this cut's nodes instead, where the next cut is.
+      // The held DOFs' rows of the factored matrix change (solve/cpu_cg_solver.cpp, D): the
+      // frame takes them when they lie in it; a refactorization frames this cut's nodes,
+      // where the next cut is.
       std::vector<int> nodes;
       for (int t : r.changed_tets)
         for (int v : model->mesh().tets[static_cast<size_t>(t)]) nodes.push_back(v);

@@ -25,19 +25,23 @@
 //             misses the tolerance.
 // A held free piece (simulation.cpp) makes A singular: its rigid modes are unanchored, though
 // every DOF of it is constrained. When the caller names the held DOFs (set_matrix(a, held)),
-// the factor is of A_kk, A without them (k = the kept DOFs): SPD, no shift, and since every
+// the factor is of D = [A_kk 0; 0 diag(A)_hh] (docs/DESIGN.md eq. (30)), A with the held rows
+// and columns cleared but for their diagonal (k = the kept DOFs, h = the held ones): SPD, no
+// shift, and since every
 // held DOF is constrained in every solve, (A_kk^-1)_ff is again the inverse of the Schur
 // complement on the free DOFs (block inverse within k), so the iteration count stays
-// #constrained-DOFs-of-k + 1. A held DOF that a solve leaves free gets Jacobi (the preconditioner
-// stays SPD). Without the held DOFs named, A + d*diag(A) with tiny d is the second attempt: it
-// keeps (A^-1)_ff of the anchored rest to ~d*cond(A) when the piece is its own connected block
-// of A, but a piece held by a hinge (a node or an edge shared with the rest) couples its
-// near-null modes, amplified by 1/d, into the free DOFs: with slivers (cond ~1e8) the
-// preconditioner degrades to Jacobi-like and CG stalls short of 1e-10. An indefinite A (no SPD
-// factor even shifted) falls back to Jacobi for that matrix; preconditioner() reports it.
+// #constrained-DOFs-of-k + 1. A held DOF that a solve leaves free gets Jacobi (D's own rows:
+// the preconditioner stays SPD). The held rows stay in D, so a change of what is held changes
+// D's rows, not its size, and the frame of section 6.2 can take it like a cut's. Without the held
+// DOFs named, A + d*diag(A) with tiny d is the second attempt: it keeps (A^-1)_ff of the anchored
+// rest to ~d*cond(A) when the piece is its own connected block of A, but a piece held by a hinge (a
+// node or an edge shared with the rest) couples its near-null modes, amplified by 1/d, into the
+// free DOFs: with slivers (cond ~1e8) the preconditioner degrades to Jacobi-like and CG stalls
+// short of 1e-10. An indefinite A (no SPD factor even shifted) falls back to Jacobi for that
+// matrix; preconditioner() reports it.
 //
-// The direct step (held_dof_solve) needs the factor of A itself: with held free-piece DOFs
-// left out of the factor (A_kk), a step is solved by the preconditioned CG alone.
+// The direct step (held_dof_solve) needs the factor of A itself, or of D when every held DOF
+// is constrained (their values move to the right-hand side).
 #include "soft_tissue_cutting/solve/framed_cholesky.hpp"
 #include "soft_tissue_cutting/solve/held_dof_solve.hpp"
 #include "soft_tissue_cutting/solve/linear_solver.hpp"
@@ -82,20 +86,21 @@ constexpr double kShift = 1e-9;
 // most cuts there to a full refactorization (cutting step median 30 -> 74 ms). A change of E
 // changes every row: no frame.
 // A frame that later cuts grew (their new DOFs, and the rows outside it they changed, which
-// join it: eq. (28)) is kept while it is at most kUpdateFrameShare of the cap: past it each
-// cut's dense refactorization would cost more than 0.75^3 = 0.42 of the sparse one, and a
-// refactorization frames the latest changes afresh. The organ liver's follow stroke (offline,
-// 172 cuts, with eq. (28)): frames kept up to the whole cap, 16 refactorizations and 3.5 GFlop
-// in frame updates; up to 0.75 of it, 19 and 2.5 GFlop; 0.63, 32 and 1.6 GFlop.
-// A frame past kPrefactorShare of the cap is refactored ahead, on a second thread, around the
-// cut that grew it (docs/DESIGN.md section 6.2, "Refactored ahead"): the next cut updates that
-// factor's fresh frame instead of this grown one, so a frame rarely reaches kUpdateFrameShare
-// and its full refactorization on the loop's thread (~20 ms on the organ liver, the cutting
-// step's maximum). Organ liver, the online follow stroke, three runs each: cutting steps'
-// solve median 5.0-6.1 -> 4.1-4.8 ms at 0.65 (0.5: 4.2-5.6, with more threads started).
+// join it: eq. (28)) is kept up to kUpdateFrameShare of the cap. Past kPrefactorShare of it, it
+// is refactored ahead, on a second thread, around the cut that grew it (docs/DESIGN.md section
+// 6.2, "Refactored ahead"): the next cut updates that factor's fresh frame instead of this
+// grown one. Before that thread, frames were kept up to 0.75 of the cap (each cut's dense
+// refactorization then cost at most 0.42 of the sparse one, and a refactorization framed the
+// latest changes afresh: organ liver's follow stroke offline, 172 cuts, up to the whole cap 16
+// refactorizations and 3.5 GFlop in frame updates, up to 0.75 19 and 2.5 GFlop); with it, a
+// grown frame is reframed off the loop's thread, and the whole cap (an update costs at most
+// what the loop's refactorization would, ~20 ms on the organ liver) takes a few more cuts
+// through the frame: offline 19 -> 17 refactorizations. Online organ follow stroke, three runs
+// each: cutting steps' solve median 5.0-6.1 -> 4.1-4.8 ms with the thread at 0.65 (0.5:
+// 4.2-5.6, more threads started).
 constexpr int kFrameRings = 2;
 constexpr double kWiderFrameShare = 0.6;
-constexpr double kUpdateFrameShare = 0.75;
+constexpr double kUpdateFrameShare = 1.0;
 constexpr double kPrefactorShare = 0.65;
 constexpr int kMinFrame = 600;
 constexpr int kMaxFrame = 1200;
@@ -125,7 +130,7 @@ class CpuCgSolver final : public LinearSolver {
     if (!factor_failed_) return -1;
     if (!singular_dof_) {
       const int c = SparseCholesky::first_failing_column(block());
-      singular_dof_ = c < 0 || kept_.empty() ? c : kept_[static_cast<size_t>(c)];
+      singular_dof_ = c;  // D's rows are A's
     }
     return *singular_dof_;
   }
@@ -146,28 +151,19 @@ class CpuCgSolver final : public LinearSolver {
     // The last factored block, kept (what the next frame is chosen against): swapped, not
     // copied, and the arrays of the one before it are re-used for the new matrix.
     SparseMatrix& previous = previous_;
-    previous.swap(kept_.empty() ? a_ : kept_block_);
+    previous.swap(any_held_ ? kept_block_ : a_);
+    if (!held.empty() && static_cast<Eigen::Index>(held.size()) != a.rows())
+      throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
+                                  " entries for " + std::to_string(a.rows()) + " DOFs");
     a_ = a;
-    kept_.clear();
     held_mask_ = Vector::Zero(a_.rows());
-    if (!held.empty()) {
-      if (static_cast<Eigen::Index>(held.size()) != a_.rows())
-        throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
-                                    " entries for " + std::to_string(a_.rows()) + " DOFs");
-      for (Eigen::Index i = 0; i < a_.rows(); ++i)
-        if (held[static_cast<size_t>(i)])
-          held_mask_[i] = 1;
-        else
-          kept_.push_back(static_cast<int>(i));
-      if (static_cast<Eigen::Index>(kept_.size()) == a_.rows()) kept_.clear();  // none held
-    }
-    kept_index_.assign(kept_.empty() ? 0 : static_cast<size_t>(a_.rows()), -1);
-    for (size_t i = 0; i < kept_.size(); ++i)
-      kept_index_[static_cast<size_t>(kept_[i])] = static_cast<int>(i);
-    if (kept_.empty())
-      kept_block_.resize(0, 0);
-    else
+    for (size_t i = 0; i < held.size(); ++i)
+      if (held[i]) held_mask_[static_cast<Eigen::Index>(i)] = 1;
+    any_held_ = !held_mask_.isZero(0);
+    if (any_held_)
       kept_block_of(a_, kept_block_);
+    else
+      kept_block_.resize(0, 0);
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -178,24 +174,26 @@ class CpuCgSolver final : public LinearSolver {
     last_.reset();
     factor_failed_ = false;
     singular_dof_.reset();
-    // The kept block's rows are the same DOFs as before when the matrix's are and no DOF of
-    // them changed its held state: then a cut within the last frame refactors the frame alone.
-    const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows &&
-                           held_mask_.head(old_rows) == old_held_mask;
-    // Rows of `a` in the block's numbering (held rows are not in the block).
-    auto block_rows = [this](const std::vector<int>& rows) {
+    // The block's rows are the same DOFs as before when the matrix's are (held or not: a held
+    // DOF keeps its row in D): then a cut within the last frame refactors the frame alone.
+    const bool same_rows = chol_ && old_rows > 0 && history.kept_rows >= old_rows;
+    auto in_range = [this](const std::vector<int>& rows) {
       std::vector<int> out;
-      for (int r : rows) {
-        if (r < 0 || r >= a_.rows()) continue;
-        const int k = kept_.empty() ? r : kept_index_[static_cast<size_t>(r)];
-        if (k >= 0) out.push_back(k);
-      }
+      for (int r : rows)
+        if (r >= 0 && r < a_.rows()) out.push_back(r);
       return out;
     };
-    // The rows changed since the factorization, when known; where the next change is expected.
+    // The rows changed since the factorization, when known (a DOF held or let go changes its
+    // row of D and its neighbours'); where the next change is expected.
     std::optional<std::vector<int>> changed, expected;
-    if (same_rows && history.changed_rows) changed = block_rows(*history.changed_rows);
-    if (history.expected_rows) expected = block_rows(*history.expected_rows);
+    if (same_rows && history.changed_rows) {
+      changed = in_range(*history.changed_rows);
+      for (Eigen::Index r = 0; r < old_rows; ++r)
+        if (held_mask_[r] != old_held_mask[r])
+          for (SparseMatrix::InnerIterator it(a_, r); it; ++it)  // r itself among them
+            changed->push_back(static_cast<int>(it.index()));
+    }
+    if (history.expected_rows) expected = in_range(*history.expected_rows);
     if (wanted_ == CgPreconditioner::kCholesky) {
       factor(same_rows, history.interface_rows, previous, changed, expected, std::move(ahead));
     } else {
@@ -258,37 +256,37 @@ class CpuCgSolver final : public LinearSolver {
     const Vector m = inv_diag_.cwiseProduct(free_mask);  // projected Jacobi preconditioner
     const auto precondition = [&](const Vector& r) -> Vector {
       if (!chol_) return m.cwiseProduct(r);
-      if (kept_.empty()) return chol_->solve(r).cwiseProduct(free_mask);
-      // Factor of A_kk on the kept DOFs; Jacobi on a held DOF this solve leaves free.
-      Vector z = m.cwiseProduct(r).cwiseProduct(held_mask_);
-      z(kept_) = chol_->solve(Vector(r(kept_)));
-      return z.cwiseProduct(free_mask);
+      // With held DOFs, D's rows are Jacobi on a held DOF this solve leaves free.
+      return chol_->solve(r).cwiseProduct(free_mask);
     };
 
     // With the factor of A: the direct solve through the capacitance on the held DOFs
     // (docs/DESIGN.md eqs. (24)-(25)), counted as one iteration, unless the warm start
     // already solves the system. Its true residual decides; CG goes on from it otherwise.
-    // With the factor of A_kk (held pieces' DOFs named in set_matrix, all of them constrained
+    // With the factor of D (held pieces' DOFs named in set_matrix, all of them constrained
     // here): the same on the kept DOFs, the held ones' values moved to the right-hand side
     // (b_k - A_kh x_h). Projected CG would need as many iterations as this solve constrains
     // kept DOFs (a press after a cut freed pieces: 9 iterations, 5.5 ms on the organ liver).
-    const bool kept_direct = !kept_.empty() && held_mask_.cwiseProduct(free_mask).isZero(0);
-    if (chol_ && (kept_.empty() || kept_direct) && settings.max_iterations > 0) {
+    const bool kept_direct = any_held_ && held_mask_.cwiseProduct(free_mask).isZero(0);
+    if (chol_ && (!any_held_ || kept_direct) && settings.max_iterations > 0) {
       const double warm = !check_warm ? std::numeric_limits<double>::infinity()
                                       : (b - a_ * x).cwiseProduct(free_mask).norm() / rhs_norm;
       if (warm > settings.tolerance) {
         Vector direct = x;
-        if (kept_.empty()) {
+        if (!any_held_) {
           held_.solve(*chol_, b, held, direct);
         } else {
-          const Vector rhs = b - a_ * x.cwiseProduct(held_mask_);
-          Vector xk = x(kept_);
-          std::vector<int> held_k;  // the constrained kept DOFs, numbered in the kept block
+          // D's held rows decouple: their values move to the right-hand side of the kept
+          // rows, and their own rows give them back (reset exactly below).
+          Vector rhs = b - a_ * x.cwiseProduct(held_mask_);
+          std::vector<int> held_k;  // the constrained kept DOFs
           for (int c : held)
-            if (kept_index_[static_cast<size_t>(c)] >= 0)
-              held_k.push_back(kept_index_[static_cast<size_t>(c)]);
-          held_.solve(*chol_, rhs(kept_), held_k, xk);
-          direct(kept_) = xk;
+            if (held_mask_[c] == 0) held_k.push_back(c);
+          for (Eigen::Index i = 0; i < n; ++i)
+            if (held_mask_[i] != 0) rhs[i] = kept_block_.coeff(i, i) * x[i];
+          held_.solve(*chol_, rhs, held_k, direct);
+          for (Eigen::Index i = 0; i < n; ++i)
+            if (held_mask_[i] != 0) direct[i] = x[i];
         }
         result.iterations = 1;
         const double res = (b - a_ * direct).cwiseProduct(free_mask).norm() / rhs_norm;
@@ -364,29 +362,33 @@ class CpuCgSolver final : public LinearSolver {
     }
   }
 
-  // The matrix to factor: A, or A_kk without the held DOFs.
-  const SparseMatrix& block() const { return kept_.empty() ? a_ : kept_block_; }
+  // The matrix to factor: A, or D with the held DOFs decoupled.
+  const SparseMatrix& block() const { return any_held_ ? kept_block_ : a_; }
 
-  // A_kk of `a` (kept_ set).
+  // D of `a` (held_mask_ set): the held rows and columns cleared but for the diagonal (1 where
+  // that is not positive).
   // Written into `out`, whose arrays (the block before last, swapped out in set_matrix) are
   // re-used: a new matrix every cut page-faulted in megabytes of fresh memory each time.
   void kept_block_of(const SparseMatrix& a, SparseMatrix& out) const {
-    // Row by row in kept order: the renumbering is increasing, so each row's columns stay
-    // sorted and the compressed arrays are written directly (no triplets, no sort).
-    const auto n = static_cast<Eigen::Index>(kept_.size());
+    // Row by row: each row's columns stay sorted, so the compressed arrays are written
+    // directly (no triplets, no sort).
+    const Eigen::Index n = a.rows();
     out.resize(n, n);
-    out.reserve(a.nonZeros());
+    out.reserve(a.nonZeros() + n);
     for (Eigen::Index i = 0; i < n; ++i) {
       out.startVec(i);
-      for (SparseMatrix::InnerIterator it(a, kept_[static_cast<size_t>(i)]); it; ++it) {
-        const int j = kept_index_[static_cast<size_t>(it.index())];
-        if (j >= 0) out.insertBack(i, j) = it.value();
+      if (held_mask_[i] != 0) {
+        const double d = a.coeff(i, i);
+        out.insertBack(i, i) = d > 0 ? d : 1.0;
+        continue;
       }
+      for (SparseMatrix::InnerIterator it(a, i); it; ++it)
+        if (held_mask_[it.index()] == 0) out.insertBack(i, it.index()) = it.value();
     }
     out.finalize();
   }
 
-  // A (or A_kk) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
+  // A (or D) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
   // active. same_rows: the block's leading rows are the last block's DOFs, so the last factor
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
   // keeps a frame around what changed since `previous` (the last block); its first `interface`
@@ -402,10 +404,7 @@ class CpuCgSolver final : public LinearSolver {
       active_ = "jacobi";
       return;
     }
-    int dense = interface;  // the interface block's rows in the block's numbering
-    if (!kept_.empty())
-      dense =
-          static_cast<int>(std::lower_bound(kept_.begin(), kept_.end(), interface) - kept_.begin());
+    const int dense = interface;  // the interface block's rows (D's rows are A's)
     // The factor refactored ahead differs from this block in this change's rows alone.
     if (ahead && same_rows && changed && active_ == "cholesky" &&
         ahead->update(
@@ -507,7 +506,7 @@ class CpuCgSolver final : public LinearSolver {
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
   std::future<std::unique_ptr<FramedCholesky>> prefactor_;  // the block's, refactored ahead
-  SparseMatrix kept_block_;  // A_kk when some DOFs are held (else the block is a_ itself)
+  SparseMatrix kept_block_;  // D when some DOFs are held (else the block is a_ itself)
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
   SparseMatrix previous_;       // the block before the last set_matrix (its arrays reused)
@@ -519,14 +518,13 @@ class CpuCgSolver final : public LinearSolver {
     CgResult result;
   };
   std::optional<LastSolve> last_;
-  // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (A_kk's and its kept DOFs'
+  // y = A^-1 b and A^-1 e_c of held DOFs for the current matrix (D's and its kept DOFs'
   // when some DOFs are held).
   HeldDofSolve held_;
-  std::vector<int> kept_;        // DOFs in the factor when some are held (empty: all)
-  std::vector<int> kept_index_;  // per DOF: its row in the kept block, or -1 (held)
-  Vector held_mask_;             // per DOF: 1 = held (named in set_matrix)
+  bool any_held_ = false;  // some DOFs named held in set_matrix: the factor is D's
+  Vector held_mask_;       // per DOF: 1 = held (named in set_matrix)
   std::string active_ = "jacobi";
-  bool factor_failed_ = false;               // A (or A_kk) has no Cholesky factor
+  bool factor_failed_ = false;               // A (or D) has no Cholesky factor
   mutable std::optional<int> singular_dof_;  // where, once asked (singular_dof())
   double setup_ms_ = 0;
   int frame_updates_ = 0;

@@ -264,6 +264,47 @@ TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
   }
 }
 
+// A DOF held (a held free piece) or let go keeps its row in the factored matrix D
+// (cpu_cg_solver.cpp): its row and its neighbours' change, which the frame takes like a cut's
+// rows. The held DOF keeps its value exactly; the others solve A_ff x_f = b_f - A_fh x_h.
+TEST(FramedCholesky, CpuSolverTakesAHeldDofThroughTheFrame) {
+  const Framed f = thigh_matrix();
+  const int n = static_cast<int>(f.a.rows());
+  const int p = n - 1;  // f.frame: p and its neighbours, what holding p changes in D
+  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
+  auto solver = make_cpu_solver();
+  LinearSolver::History fresh;
+  fresh.interface_rows = f.dense;
+  fresh.expected_rows = &f.frame;  // framed with one ring more
+  solver->set_matrix(f.a, {}, fresh);
+  const std::vector<int> none;
+  LinearSolver::History same;
+  same.kept_rows = n;
+  same.interface_rows = f.dense;
+  same.changed_rows = &none;  // the matrix is the same; only what is held changes
+  std::vector<std::uint8_t> held(static_cast<size_t>(n), 0);
+  held[static_cast<size_t>(p)] = 1;
+  solver->set_matrix(f.a, held, same);
+  EXPECT_EQ(solver->frame_updates(), 1) << "holding a DOF inside the frame refactors it alone";
+  Vector x = Vector::Zero(n);
+  x[p] = 1e-3;
+  std::vector<std::uint8_t> constrained = held;
+  const CgResult r = solver->solve(b, x, constrained, CgSettings{1e-12, 50});
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.iterations, 1) << "the direct step";
+  EXPECT_EQ(x[p], 1e-3);
+  Vector residual = b - f.a * x;
+  residual[p] = 0;
+  EXPECT_LE(residual.norm() / b.norm(), 1e-11);
+  // Let go again: the frame takes that too, and the solve is the plain one.
+  solver->set_matrix(f.a, {}, same);
+  EXPECT_EQ(solver->frame_updates(), 2);
+  x.setZero();
+  EXPECT_TRUE(solver->solve(b, x, {}, CgSettings{1e-12, 50}).converged);
+  const Vector ref = SparseCholesky(f.a).solve(b);
+  EXPECT_LE((x - ref).norm() / ref.norm(), 1e-11);
+}
+
 // Rows outside the frame join it as extra rows, one change after another, and new DOFs may
 // couple to them; each time the factor solves the new matrix as exactly as a fresh one.
 TEST(FramedCholesky, TakesAFewRowsOutsideTheFrameOneChangeAfterAnother) {
