@@ -86,27 +86,39 @@ constexpr double kShift = 1e-9;
 // most cuts there to a full refactorization (cutting step median 30 -> 74 ms). A change of E
 // changes every row: no frame.
 // A frame that later cuts grew (their new DOFs, and the rows outside it they changed, which
-// join it: eq. (28)) is kept up to kUpdateFrameShare of the cap. Past kPrefactorShare of it, it
+// join it: eq. (28)) is kept up to update_limit (below). Past kPrefactorShare of the cap, it
 // is refactored ahead, on a second thread, around the cut that grew it (docs/DESIGN.md section
 // 6.2, "Refactored ahead"): the next cut updates that factor's fresh frame instead of this
 // grown one. Before that thread, frames were kept up to 0.75 of the cap (each cut's dense
 // refactorization then cost at most 0.42 of the sparse one, and a refactorization framed the
 // latest changes afresh: organ liver's follow stroke offline, 172 cuts, up to the whole cap 16
 // refactorizations and 3.5 GFlop in frame updates, up to 0.75 19 and 2.5 GFlop); with it, a
-// grown frame is reframed off the loop's thread, and the whole cap (an update costs at most
-// what the loop's refactorization would, ~20 ms on the organ liver) takes a few more cuts
-// through the frame: offline 19 -> 17 refactorizations. Online organ follow stroke, three runs
-// each: cutting steps' solve median 5.0-6.1 -> 4.1-4.8 ms with the thread at 0.65 (0.5:
-// 4.2-5.6, more threads started).
+// grown frame is reframed off the loop's thread, and where the cap is what a refactorization
+// costs, the whole cap takes a few more cuts through the frame (offline organ stroke 19 -> 17
+// refactorizations). Online organ follow stroke, three runs each: cutting steps' solve median
+// 5.0-6.1 -> 4.1-4.8 ms with the thread at 0.65 (0.5: 4.2-5.6, more threads started).
 constexpr int kFrameRings = 2;
 constexpr double kWiderFrameShare = 0.6;
-constexpr double kUpdateFrameShare = 1.0;
+constexpr double kUpdateFrameShare = 0.75;
 constexpr double kPrefactorShare = 0.65;
 constexpr int kMinFrame = 600;
 constexpr int kMaxFrame = 1200;
 int max_frame(Eigen::Index rows, double refactor_flops) {
   const int worth = static_cast<int>(std::cbrt(3 * std::max(refactor_flops, 0.0)));
   return std::min({static_cast<int>(rows / 2), kMaxFrame, std::max(kMinFrame, worth)});
+}
+// Whether a refactorization costs at least a dense frame of the whole cap (the organ liver, 200k
+// tets): then frames are kept up to the cap and refactored ahead (kPrefactorShare). Not the
+// thigh, whose cap is kMinFrame: a 600-DOF frame's dense factor, ~4 ms, costs twice its
+// refactorization (the whole cap and the thread there took its cutting median 3.3 -> 3.8 ms and
+// its maximum 9-12 -> 13-15 ms).
+bool refactor_is_dear(Eigen::Index rows, double refactor_flops) {
+  return std::cbrt(3 * std::max(refactor_flops, 0.0)) >= max_frame(rows, refactor_flops);
+}
+// The largest frame an update may make.
+int update_limit(Eigen::Index rows, double refactor_flops) {
+  const int cap = max_frame(rows, refactor_flops);
+  return refactor_is_dear(rows, refactor_flops) ? cap : static_cast<int>(kUpdateFrameShare * cap);
 }
 
 std::string format_residual(double r) {
@@ -407,9 +419,7 @@ class CpuCgSolver final : public LinearSolver {
     const int dense = interface;  // the interface block's rows (D's rows are A's)
     // The factor refactored ahead differs from this block in this change's rows alone.
     if (ahead && same_rows && changed && active_ == "cholesky" &&
-        ahead->update(
-            block, &*changed,
-            static_cast<int>(kUpdateFrameShare * max_frame(block.rows(), ahead->factor_flops())))) {
+        ahead->update(block, &*changed, update_limit(block.rows(), ahead->factor_flops()))) {
       chol_ = std::move(ahead);
       changed_since_factor_ = *changed;
       ++frame_updates_;
@@ -423,9 +433,10 @@ class CpuCgSolver final : public LinearSolver {
     if (same_rows && active_ == "cholesky") {
       const int cap = max_frame(block.rows(), chol_->factor_flops());
       if (chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr,
-                        static_cast<int>(kUpdateFrameShare * cap))) {
+                        update_limit(block.rows(), chol_->factor_flops()))) {
         ++frame_updates_;
-        if (changed && chol_->frame_size() > kPrefactorShare * cap)
+        if (changed && chol_->frame_size() > kPrefactorShare * cap &&
+            refactor_is_dear(block.rows(), chol_->factor_flops()))
           prefactor(frame_for(block, previous, changed, dense, cap));
         return;
       }
