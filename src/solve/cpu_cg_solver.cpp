@@ -57,6 +57,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace stc {
@@ -494,15 +495,18 @@ class CpuCgSolver final : public LinearSolver {
   void prefactor(std::vector<int> frame) {
     if (frame.empty()) return;
     const SparseMatrix& block = this->block();
-    prefactor_ = std::async(std::launch::async, [&block, frame = std::move(frame)]() {
-      settle_openmp_on_this_thread();  // CHOLMOD at full speed on this thread (blas_guard.hpp)
-      std::unique_ptr<FramedCholesky> f;
-      try {
-        f = std::make_unique<FramedCholesky>(block, frame);
-      } catch (const std::runtime_error&) {  // not positive definite: the loop's path will say
-      }
-      return f;
-    });
+    try {
+      prefactor_ = std::async(std::launch::async, [&block, frame = std::move(frame)]() {
+        settle_openmp_on_this_thread();  // CHOLMOD at full speed on this thread (blas_guard.hpp)
+        std::unique_ptr<FramedCholesky> f;
+        try {
+          f = std::make_unique<FramedCholesky>(block, frame);
+        } catch (const std::exception&) {  // not positive definite, out of memory: the loop's
+        }                                  // own refactorization meets it and says so
+        return f;
+      });
+    } catch (const std::system_error&) {  // no thread to be had: the loop refactors when due
+    }
   }
 
   // The factor refactored ahead, waiting for it (null if none was started or it failed): one
