@@ -164,7 +164,7 @@ class CpuCgSolver final : public LinearSolver {
     // The last factored block, kept (what the next frame is chosen against): swapped, not
     // copied, and the arrays of the one before it are re-used for the new matrix.
     SparseMatrix& previous = previous_;
-    previous.swap(any_held_ ? kept_block_ : a_);
+    previous.swap(any_held_ ? decoupled_ : a_);
     if (!held.empty() && static_cast<Eigen::Index>(held.size()) != a.rows())
       throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
                                   " entries for " + std::to_string(a.rows()) + " DOFs");
@@ -174,9 +174,9 @@ class CpuCgSolver final : public LinearSolver {
       if (held[i]) held_mask_[static_cast<Eigen::Index>(i)] = 1;
     any_held_ = !held_mask_.isZero(0);
     if (any_held_)
-      kept_block_of(a_, kept_block_);
+      decoupled_of(a_, decoupled_);
     else
-      kept_block_.resize(0, 0);
+      decoupled_.resize(0, 0);
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -296,7 +296,7 @@ class CpuCgSolver final : public LinearSolver {
           for (int c : held)
             if (held_mask_[c] == 0) held_k.push_back(c);
           for (Eigen::Index i = 0; i < n; ++i)
-            if (held_mask_[i] != 0) rhs[i] = kept_block_.coeff(i, i) * x[i];
+            if (held_mask_[i] != 0) rhs[i] = decoupled_.coeff(i, i) * x[i];
           held_.solve(*chol_, rhs, held_k, direct);
           for (Eigen::Index i = 0; i < n; ++i)
             if (held_mask_[i] != 0) direct[i] = x[i];
@@ -376,13 +376,13 @@ class CpuCgSolver final : public LinearSolver {
   }
 
   // The matrix to factor: A, or D with the held DOFs decoupled.
-  const SparseMatrix& block() const { return any_held_ ? kept_block_ : a_; }
+  const SparseMatrix& block() const { return any_held_ ? decoupled_ : a_; }
 
   // D of `a` (held_mask_ set): the held rows and columns cleared but for the diagonal (1 where
   // that is not positive).
   // Written into `out`, whose arrays (the block before last, swapped out in set_matrix) are
   // re-used: a new matrix every cut page-faulted in megabytes of fresh memory each time.
-  void kept_block_of(const SparseMatrix& a, SparseMatrix& out) const {
+  void decoupled_of(const SparseMatrix& a, SparseMatrix& out) const {
     // Row by row: each row's columns stay sorted, so the compressed arrays are written
     // directly (no triplets, no sort).
     const Eigen::Index n = a.rows();
@@ -521,7 +521,7 @@ class CpuCgSolver final : public LinearSolver {
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
   std::future<std::unique_ptr<FramedCholesky>> prefactor_;  // the block's, refactored ahead
-  SparseMatrix kept_block_;  // D when some DOFs are held (else the block is a_ itself)
+  SparseMatrix decoupled_;  // D when some DOFs are held (else the block is a_ itself)
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
   SparseMatrix previous_;       // the block before the last set_matrix (its arrays reused)

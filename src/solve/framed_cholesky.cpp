@@ -135,30 +135,42 @@ struct FramedCholesky::Impl {
     return out;
   }
 
-  // Rows `positions` (< n_f) of L_FF, transposed: n_f x |positions|. They are M = L_FF^-1 A_FX
-  // for those rows X (A_FX = A_FF E_X = L_FF L_FF^T E_X), read from the supernodes' row lists
-  // instead of solved for.
-  Eigen::MatrixXd l_rows_transposed(const std::vector<int>& positions) const {
-    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_f, static_cast<Eigen::Index>(positions.size()));
-    std::vector<int> column_of(position.size(), -1);
-    for (size_t j = 0; j < positions.size(); ++j)
-      column_of[static_cast<size_t>(positions[j])] = static_cast<int>(j);
+  // Visits L's stored lower part in columns [first, last), row by row within each supernode:
+  // f(row, c0, c1, v, stride) with L(row, c) = v[(c - c0) * stride] for c0 <= c < c1 <= row + 1.
+  // (Supernode s is a column-major block: its rows are Ls[pi[s] .. pi[s+1]), its columns
+  // super[s] .. super[s+1].)
+  template <typename RowSegment>
+  void for_each_l_row_segment(int first, int last, RowSegment f) const {
     const auto* super = static_cast<const int*>(factor->super);
     const auto* pi = static_cast<const int*>(factor->pi);
     const auto* px = static_cast<const int*>(factor->px);
     const auto* ls = static_cast<const int*>(factor->s);
     const auto* lx = static_cast<const double*>(factor->x);
-    for (size_t sn = 0; sn < factor->nsuper && super[sn] < n_f; ++sn) {
-      const int nrows = pi[sn + 1] - pi[sn], last = std::min(super[sn + 1], n_f);
+    for (size_t sn = 0; sn < factor->nsuper && super[sn] < last; ++sn) {
+      if (super[sn + 1] <= first) continue;
+      const int nrows = pi[sn + 1] - pi[sn];
+      const int c0 = std::max(super[sn], first), c1 = std::min(super[sn + 1], last);
       for (int ii = 0; ii < nrows; ++ii) {
-        const int row = ls[pi[sn] + ii];
-        const int j =
-            row < static_cast<int>(column_of.size()) ? column_of[static_cast<size_t>(row)] : -1;
-        if (j < 0) continue;
-        for (int c = super[sn]; c < last && c <= row; ++c)  // the lower part: column <= row
-          out(c, j) = lx[px[sn] + static_cast<ptrdiff_t>(c - super[sn]) * nrows + ii];
+        const int row = ls[pi[sn] + ii], end = std::min(c1, row + 1);
+        if (end > c0)
+          f(row, c0, end, lx + px[sn] + static_cast<ptrdiff_t>(c0 - super[sn]) * nrows + ii, nrows);
       }
     }
+  }
+
+  // Rows `positions` (< n_f) of L_FF, transposed: n_f x |positions|. They are M = L_FF^-1 A_FX
+  // for those rows X (A_FX = A_FF E_X = L_FF L_FF^T E_X), read from the factor instead of
+  // solved for.
+  Eigen::MatrixXd l_rows_transposed(const std::vector<int>& positions) const {
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n_f, static_cast<Eigen::Index>(positions.size()));
+    std::vector<int> column_of(position.size(), -1);
+    for (size_t j = 0; j < positions.size(); ++j)
+      column_of[static_cast<size_t>(positions[j])] = static_cast<int>(j);
+    for_each_l_row_segment(0, n_f, [&](int row, int c0, int c1, const double* v, int stride) {
+      const int j = column_of[static_cast<size_t>(row)];
+      for (int c = c0; j >= 0 && c < c1; ++c)
+        out(c, j) = v[static_cast<ptrdiff_t>(c - c0) * stride];
+    });
     return out;
   }
 
@@ -168,8 +180,10 @@ struct FramedCholesky::Impl {
   std::optional<Extra> extended(const Extra& from, const std::vector<int>& added) const {
     const int n_old = static_cast<int>(factored.rows()), nb = n_old - n_f;
     const int k = static_cast<int>(added.size()), k0 = static_cast<int>(from.rows.size());
-    Extra x = from;
+    Extra x;  // T and W'' are made anew below: from's are not copied
+    x.rows = from.rows;
     x.rows.insert(x.rows.end(), added.begin(), added.end());
+    x.positions = from.positions;
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_old, k);
     std::vector<int> added_positions;
     for (int j = 0; j < k; ++j) {
@@ -185,15 +199,15 @@ struct FramedCholesky::Impl {
       const auto blas = blas_guard();
       lower_times(l_bb, false, q);
     }
-    auto append = [](Eigen::MatrixXd& to, const Eigen::MatrixXd& cols) {
-      Eigen::MatrixXd out(cols.rows(), to.cols() + cols.cols());
-      if (to.cols() > 0) out.leftCols(to.cols()) = to;
+    auto joined = [](const Eigen::MatrixXd& left, const Eigen::MatrixXd& cols) {
+      Eigen::MatrixXd out(cols.rows(), left.cols() + cols.cols());
+      if (left.cols() > 0) out.leftCols(left.cols()) = left;
       out.rightCols(cols.cols()) = cols;
-      to = std::move(out);
+      return out;
     };
-    append(x.y, l.topLeftCorner(n_f, k));
-    append(x.m, l_rows_transposed(added_positions));
-    append(x.q, q);
+    x.y = joined(from.y, l.topLeftCorner(n_f, k));
+    x.m = joined(from.m, l_rows_transposed(added_positions));
+    x.q = joined(from.q, q);
     const int nx = k0 + k;
     Eigen::MatrixXd a_xb = Eigen::MatrixXd::Zero(nx, nb);  // of the factored matrix
     Eigen::MatrixXd a_xx = Eigen::MatrixXd::Zero(nx, nx);
@@ -277,24 +291,13 @@ FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
   m.position.assign(static_cast<size_t>(n), 0);
   for (int k = 0; k < n; ++k) m.position[static_cast<size_t>(m.perm[static_cast<size_t>(k)])] = k;
 
-  // L_BB from the supernodes (column-major blocks: the rows of supernode s are
-  // Ls[pi[s] .. pi[s+1]), its columns super[s] .. super[s+1]).
+  // L_BB, the factor's trailing frame block.
   const int nb = static_cast<int>(frame_.size());
   m.l_bb = Eigen::MatrixXd::Zero(nb, nb);
-  const auto* super = static_cast<const int*>(m.factor->super);
-  const auto* pi = static_cast<const int*>(m.factor->pi);
-  const auto* px = static_cast<const int*>(m.factor->px);
-  const auto* ls = static_cast<const int*>(m.factor->s);
-  const auto* lx = static_cast<const double*>(m.factor->x);
-  for (size_t s = 0; s < m.factor->nsuper; ++s) {
-    if (super[s + 1] <= m.n_f) continue;
-    const int nrows = pi[s + 1] - pi[s];
-    for (int j = std::max(super[s], m.n_f); j < super[s + 1]; ++j) {
-      const double* col = lx + px[s] + static_cast<ptrdiff_t>(j - super[s]) * nrows;
-      for (int ii = j - super[s]; ii < nrows; ++ii)  // rows >= j: the lower part
-        m.l_bb(ls[pi[s] + ii] - m.n_f, j - m.n_f) = col[ii];
-    }
-  }
+  m.for_each_l_row_segment(m.n_f, n, [&](int row, int c0, int c1, const double* v, int stride) {
+    for (int c = c0; c < c1; ++c)
+      m.l_bb(row - m.n_f, c - m.n_f) = v[static_cast<ptrdiff_t>(c - c0) * stride];
+  });
   // W = A_BB - L_BB L_BB^T (eq. (26)): what F adds to the frame's Schur complement.
   std::vector<int> pos(static_cast<size_t>(n), -1);
   for (int j = 0; j < nb; ++j) pos[static_cast<size_t>(frame_[static_cast<size_t>(j)])] = j;
