@@ -40,6 +40,10 @@ Scene thigh_stroke() {
   return thigh;
 }
 
+Scene tetgen_liver() {  // config/scenes/liver_cut.yaml: a TetGen liver sagging under gravity
+  return load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/liver_cut.yaml");
+}
+
 struct StrokeCounts {
   int cuts = 0, updates = 0, checked = 0;
 };
@@ -58,7 +62,7 @@ StrokeCounts framed_along_stroke(const Scene& scene, const std::string& what) {
     if (!s.cutting) continue;
     ++n.cuts;
     const SparseMatrix& a = sim.model().hybrid_matrix();
-    // A held free piece may leave A singular (its factor is of A without the held DOFs,
+    // A held free piece may leave A singular (its factor is of D, the held DOFs decoupled,
     // cpu_cg_solver.cpp): those steps are the solver's test below.
     const auto& held = sim.model().held_nodes();
     if (std::find(held.begin(), held.end(), 1) != held.end()) {
@@ -97,10 +101,7 @@ TEST(FramedCholesky, CutStrokeEqualsFreshFactorOnThigh) {
 }
 
 TEST(FramedCholesky, CutStrokeEqualsFreshFactorOnTetgenLiver) {
-  // config/scenes/liver_cut.yaml: a TetGen liver sagging under gravity, pressed and cut.
-  const StrokeCounts n = framed_along_stroke(
-      load_scene(std::string(TISSUE_TEST_DATA_DIR) + "/../../config/scenes/liver_cut.yaml"),
-      "TetGen liver");
+  const StrokeCounts n = framed_along_stroke(tetgen_liver(), "TetGen liver");
   EXPECT_GE(n.cuts, 10);
   EXPECT_GE(2 * n.updates, n.cuts) << n.updates << " of " << n.cuts << " cuts updated the frame";
 }
@@ -113,8 +114,8 @@ struct Framed {
   int dense = 0;     // the interface rows
 };
 
-Framed thigh_matrix() {
-  const HybridModel h(make_thigh_scene());
+Framed framed_matrix(const Scene& scene) {
+  const HybridModel h(scene);
   Framed f;
   f.a = h.hybrid_matrix();
   const int dense = 3 * static_cast<int>(h.partition().interface.size());
@@ -132,6 +133,8 @@ Framed thigh_matrix() {
     }
   return f;
 }
+
+Framed thigh_matrix() { return framed_matrix(make_thigh_scene()); }
 
 TEST(FramedCholesky, FrameAroundChangesIsTheChangedRowsAndTheirNeighbours) {
   const Framed f = thigh_matrix();
@@ -268,41 +271,46 @@ TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
 // (cpu_cg_solver.cpp): its row and its neighbours' change, which the frame takes like a cut's
 // rows. The held DOF keeps its value exactly; the others solve A_ff x_f = b_f - A_fh x_h.
 TEST(FramedCholesky, CpuSolverTakesAHeldDofThroughTheFrame) {
-  const Framed f = thigh_matrix();
-  const int n = static_cast<int>(f.a.rows());
-  const int p = n - 1;  // f.frame: p and its neighbours, what holding p changes in D
-  const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
-  auto solver = make_cpu_solver();
-  LinearSolver::History fresh;
-  fresh.interface_rows = f.dense;
-  fresh.expected_rows = &f.frame;  // framed with one ring more
-  solver->set_matrix(f.a, {}, fresh);
-  const std::vector<int> none;
-  LinearSolver::History same;
-  same.kept_rows = n;
-  same.interface_rows = f.dense;
-  same.changed_rows = &none;  // the matrix is the same; only what is held changes
-  std::vector<std::uint8_t> held(static_cast<size_t>(n), 0);
-  held[static_cast<size_t>(p)] = 1;
-  solver->set_matrix(f.a, held, same);
-  EXPECT_EQ(solver->frame_updates(), 1) << "holding a DOF inside the frame refactors it alone";
-  Vector x = Vector::Zero(n);
-  x[p] = 1e-3;
-  std::vector<std::uint8_t> constrained = held;
-  const CgResult r = solver->solve(b, x, constrained, CgSettings{1e-12, 50});
-  EXPECT_TRUE(r.converged);
-  EXPECT_EQ(r.iterations, 1) << "the direct step";
-  EXPECT_EQ(x[p], 1e-3);
-  Vector residual = b - f.a * x;
-  residual[p] = 0;
-  EXPECT_LE(residual.norm() / b.norm(), 1e-11);
-  // Let go again: the frame takes that too, and the solve is the plain one.
-  solver->set_matrix(f.a, {}, same);
-  EXPECT_EQ(solver->frame_updates(), 2);
-  x.setZero();
-  EXPECT_TRUE(solver->solve(b, x, {}, CgSettings{1e-12, 50}).converged);
-  const Vector ref = SparseCholesky(f.a).solve(b);
-  EXPECT_LE((x - ref).norm() / ref.norm(), 1e-11);
+  for (const auto& [what, scene] :
+       {std::pair<std::string, Scene>{"thigh", make_thigh_scene()},
+        std::pair<std::string, Scene>{"TetGen liver", tetgen_liver()}}) {
+    SCOPED_TRACE(what);
+    const Framed f = framed_matrix(scene);
+    const int n = static_cast<int>(f.a.rows());
+    const int p = n - 1;  // f.frame: p and its neighbours, what holding p changes in D
+    const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
+    auto solver = make_cpu_solver();
+    LinearSolver::History fresh;
+    fresh.interface_rows = f.dense;
+    fresh.expected_rows = &f.frame;  // framed with one ring more
+    solver->set_matrix(f.a, {}, fresh);
+    const std::vector<int> none;
+    LinearSolver::History same;
+    same.kept_rows = n;
+    same.interface_rows = f.dense;
+    same.changed_rows = &none;  // the matrix is the same; only what is held changes
+    std::vector<std::uint8_t> held(static_cast<size_t>(n), 0);
+    held[static_cast<size_t>(p)] = 1;
+    solver->set_matrix(f.a, held, same);
+    EXPECT_EQ(solver->frame_updates(), 1) << "holding a DOF inside the frame refactors it alone";
+    Vector x = Vector::Zero(n);
+    x[p] = 1e-3;
+    std::vector<std::uint8_t> constrained = held;
+    const CgResult r = solver->solve(b, x, constrained, CgSettings{1e-12, 50});
+    EXPECT_TRUE(r.converged);
+    EXPECT_EQ(r.iterations, 1) << "the direct step";
+    EXPECT_EQ(x[p], 1e-3);
+    Vector residual = b - f.a * x;
+    residual[p] = 0;
+    EXPECT_LE(residual.norm() / b.norm(), 1e-11);
+    // Let go again: the frame takes that too, and the solve is the plain one.
+    solver->set_matrix(f.a, {}, same);
+    EXPECT_EQ(solver->frame_updates(), 2);
+    x.setZero();
+    EXPECT_TRUE(solver->solve(b, x, {}, CgSettings{1e-12, 50}).converged);
+    const Vector ref = SparseCholesky(f.a).solve(b);
+    EXPECT_LE((x - ref).norm() / ref.norm(), 1e-11);
+  }
 }
 
 // Rows outside the frame join it as extra rows, one change after another, and new DOFs may
