@@ -113,8 +113,12 @@ int max_frame(Eigen::Index rows, double refactor_flops) {
 // thigh, whose cap is kMinFrame: a 600-DOF frame's dense factor, ~4 ms, costs twice its
 // refactorization (the whole cap and the thread there took its cutting median 3.3 -> 3.8 ms and
 // its maximum 9-12 -> 13-15 ms).
+// A small operation part whose cap is rows / 2, below the floor, is not dear either (the thigh
+// soak's random cuts met that now and then: threads started for ~2 ms refactorizations, and the
+// soak's RSS grew past its limit once, 72 MB).
 bool refactor_is_dear(Eigen::Index rows, double refactor_flops) {
-  return std::cbrt(3 * std::max(refactor_flops, 0.0)) >= max_frame(rows, refactor_flops);
+  const double worth = std::cbrt(3 * std::max(refactor_flops, 0.0));
+  return worth >= kMinFrame && worth >= max_frame(rows, refactor_flops);
 }
 // The largest frame an update may make.
 int update_limit(Eigen::Index rows, double refactor_flops) {
