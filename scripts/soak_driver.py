@@ -5,14 +5,18 @@ and reports whether it stayed live and honest.
 Load: a random-walk scalpel on scalpel/pose at 100 Hz around the operation region (it presses,
 cuts and leaves the tissue again), every ~5 s a burst of service calls from 4 threads
 (~set_cutting, short ~cut paths, ~save), every ~60 s a ~reset. Measured: steps, cuts, worst
-step (~stats step_ms), ~stats rate per 1 s window (percentiles), node RSS start/end, every
-non-finite number in ~stats, ~scalpel/wrench and ~surface, the longest time without a ~stats
-message, /diagnostics levels, node deaths.
+step (~stats step_ms), ~stats rate per 1 s window (percentiles), node RSS at the start, its peak
+(with the tets the model had then), at the end and after a final ~reset, every non-finite number
+in ~stats, ~scalpel/wrench and ~surface, the longest time without a ~stats message,
+/diagnostics levels, node deaths.
 
 Pass/fail (the last line says PASS or FAIL and why; exit 1 on FAIL): the node stays alive, no
-non-finite number is published, no service call fails (crash or hang), RSS grows by at most
---max-rss-growth-mb from the start (after a 5 s warm-up) to the end, and no stall: ~stats never
-goes quiet for longer than --max-gap-s."""
+non-finite number is published, no service call fails (crash or hang), no stall (~stats never
+goes quiet for longer than --max-gap-s), and memory: while cutting, RSS grows (peak - start,
+after a 5 s warm-up) by at most --max-rss-growth-mb plus --max-kb-per-tet for each tet the cuts
+added - the cut model grows, and a faster loop cuts more in a minute - and after a final ~reset
+(the initial model again, the freed heap given back) RSS is within --max-rss-leak-mb of the
+start: what stays held something that outlived its model, a leak."""
 import argparse
 import math
 import os
@@ -58,6 +62,8 @@ class Soak:
         self.first_step = None
         self.last_step = 0
         self.cuts_total = 0
+        self.model_now = (0, 0, 0)  # tets, nodes, free DOFs of the last ~stats
+        self.peak_tets = 0
         self.cuts_seen = 0
         self.worst_step_ms = 0.0
         self.stats_per_second = {}
@@ -97,6 +103,8 @@ class Soak:
             self.cuts_total += m.cuts - self.cuts_seen
             self.cuts_seen = m.cuts
             self.worst_step_ms = max(self.worst_step_ms, m.step_ms)
+            self.model_now = (m.tets, m.nodes, m.dof_operation)
+            self.peak_tets = max(self.peak_tets, m.tets)
             sec = int(time.monotonic())
             self.stats_per_second[sec] = self.stats_per_second.get(sec, 0) + 1
 
@@ -171,10 +179,12 @@ class Soak:
             ok = getattr(r, "success", True)
             with self.lock:
                 self.calls["ok" if ok else "refused"] += 1
+            return ok
         except Exception as e:  # a crashed or hung node shows here
             with self.lock:
                 self.calls["failed"] += 1
             rospy.logwarn("soak: service call failed: %s", e)
+            return False
 
     def burst(self, rng, tmp):
         set_cutting = rospy.ServiceProxy("/tissue/set_cutting", SetBool)
@@ -232,6 +242,7 @@ class Soak:
         rss_start = rss_mb(a.pid)
         with self.lock:
             self.measuring = True
+            model_start = self.model_now
         rng = random.Random(7)
         reset = rospy.ServiceProxy("/tissue/reset", Trigger)
         tmp = tempfile.mkdtemp(prefix="soak_")
@@ -239,11 +250,16 @@ class Soak:
         end = t0 + 60.0 * a.minutes
         next_burst, next_reset, next_print = t0 + 5, t0 + 60, t0 + 60
         died = False
+        rss_peak, tets_at_peak = rss_start, model_start[0]
         while time.monotonic() < end and not rospy.is_shutdown():
             now = time.monotonic()
             if not os.path.exists("/proc/%d" % a.pid):
                 died = True
                 break
+            rss = rss_mb(a.pid)
+            if rss > rss_peak:
+                with self.lock:
+                    rss_peak, tets_at_peak = rss, self.model_now[0]
             if now >= next_burst:
                 self.burst(rng, tmp)
                 next_burst = now + 5
@@ -260,8 +276,21 @@ class Soak:
                 next_print = now + 60
             time.sleep(0.2)
         rss_end = rss_mb(a.pid)
+        with self.lock:
+            model_end = self.model_now
+        if rss_end > rss_peak:
+            rss_peak, tets_at_peak = rss_end, model_end[0]
         stop.set()
         walker.join()
+        # Leak check at equal model state: a final ~reset rebuilds the initial model and the node
+        # gives the freed heap back (malloc_trim), so what stays above the start is held by
+        # something that outlived its model.
+        rss_reset = float("nan")
+        if not died and os.path.exists("/proc/%d" % a.pid) and self.call(reset):
+            with self.lock:
+                self.resets += 1
+            time.sleep(2.0)
+            rss_reset = rss_mb(a.pid)
         with self.lock:
             if self.last_stats_time is not None:  # a gap still open at the end counts too
                 self.longest_gap_s = max(self.longest_gap_s, time.monotonic() - self.last_stats_time)
@@ -277,7 +306,13 @@ class Soak:
                 "  rate (Hz, 1 s):   p1 %s  p5 %s  p50 %s  p95 %s  min %s" % (
                     percentile(rates, 1), percentile(rates, 5), percentile(rates, 50),
                     percentile(rates, 95), min(rates) if rates else "nan"),
-                "  RSS:              %.0f MB -> %.0f MB" % (rss_start, rss_end),
+                "  RSS:              %.0f MB -> %.0f MB (peak %.0f MB at %d tets), %.0f MB after "
+                "a final ~reset" % (rss_start, rss_end, rss_peak, tets_at_peak, rss_reset),
+                "  model:            %d -> %d tets (peak %d), %d -> %d nodes, %d -> %d free DOFs; "
+                "%.1f KB of RSS per tet the cuts added" % (
+                    model_start[0], model_end[0], self.peak_tets, model_start[1], model_end[1],
+                    model_start[2], model_end[2],
+                    1024 * (rss_peak - rss_start) / max(1, tets_at_peak - model_start[0])),
                 "  service calls:    %d ok, %d refused, %d failed; %d resets" % (
                     self.calls["ok"], self.calls["refused"], self.calls["failed"], self.resets),
                 "  non-finite:       %d stats, %d wrench, %d surface (of %d surfaces)" % (
@@ -290,7 +325,13 @@ class Soak:
                         "%s: %d" % kv for kv in sorted(self.diagnostics_errors.items())) + ")"),
                 "  node:             %s" % ("DIED" if died else "alive"),
             ]
-            growth = rss_end - rss_start
+            growth = rss_peak - rss_start
+            # The cut model grows (new tets, a larger operation part and its factor): the budget
+            # is a fixed slack plus a cost per tet the cuts added, so a faster loop that cuts
+            # more in a minute is not mistaken for a leak - the final reset measures leaks.
+            added = max(0, tets_at_peak - model_start[0])
+            budget = a.max_rss_growth_mb + a.max_kb_per_tet * added / 1024.0
+            leak = rss_reset - rss_start
             failures = []
             if died:
                 failures.append("the node died")
@@ -298,8 +339,13 @@ class Soak:
                 failures.append("%d non-finite outputs" % sum(self.nonfinite.values()))
             if self.calls["failed"] > 0:
                 failures.append("%d service calls failed" % self.calls["failed"])
-            if not math.isfinite(growth) or growth > a.max_rss_growth_mb:
-                failures.append("RSS grew by %.0f MB (limit %.0f MB)" % (growth, a.max_rss_growth_mb))
+            if not math.isfinite(growth) or growth > budget:
+                failures.append("RSS grew by %.0f MB while cutting (limit %.0f MB + %.0f KB for "
+                                "each of %d tets added = %.0f MB)" % (
+                                    growth, a.max_rss_growth_mb, a.max_kb_per_tet, added, budget))
+            if not died and (not math.isfinite(leak) or leak > a.max_rss_leak_mb):
+                failures.append("RSS %.0f MB above the start after a final ~reset (limit %.0f MB)" % (
+                    leak, a.max_rss_leak_mb))
             if self.steps == 0 or self.longest_gap_s > a.max_gap_s:
                 failures.append("stall: no ~stats for %.2f s (limit %.2f s)" % (
                     self.longest_gap_s, a.max_gap_s))
@@ -317,7 +363,12 @@ def main():
     p.add_argument("--pid", type=int, required=True)
     p.add_argument("--out", default="/tmp")
     p.add_argument("--max-rss-growth-mb", type=float, default=64.0,
-                   help="fail if the node's RSS grows by more (end - start after warm-up)")
+                   help="fail if the node's RSS grows by more than this plus --max-kb-per-tet for "
+                   "each tet the cuts added (peak - start after warm-up)")
+    p.add_argument("--max-kb-per-tet", type=float, default=16.0,
+                   help="RSS allowed per tet the cuts added (the thigh's cut model: ~10 KB)")
+    p.add_argument("--max-rss-leak-mb", type=float, default=16.0,
+                   help="fail if RSS after a final ~reset stays more than this above the start")
     p.add_argument("--startup-s", type=float, default=600.0,
                    help="fail if the node has not stepped (and drawn its region) by then")
     p.add_argument("--max-gap-s", type=float, default=2.0,
