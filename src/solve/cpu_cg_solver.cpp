@@ -126,6 +126,24 @@ int update_limit(Eigen::Index rows, double refactor_flops) {
   return refactor_is_dear(rows, refactor_flops) ? cap : static_cast<int>(kUpdateFrameShare * cap);
 }
 
+// `out` holds `a`'s rows before `first` already, bit for bit: the rest of `a` is copied after
+// them (both compressed; else, or if the two disagree where the rows meet, all of `a`).
+void copy_rows_after(const SparseMatrix& a, Eigen::Index first, SparseMatrix& out) {
+  if (!a.isCompressed() || !out.isCompressed() || first > out.rows() || first > a.rows() ||
+      out.outerIndexPtr()[first] != a.outerIndexPtr()[first]) {
+    out = a;
+    return;
+  }
+  const int base = a.outerIndexPtr()[first];
+  const int nnz = static_cast<int>(a.nonZeros());
+  out.conservativeResize(a.rows(), a.cols());
+  out.data().resize(nnz, 0.125);  // room for the next cuts' entries
+  std::copy(a.outerIndexPtr() + first, a.outerIndexPtr() + a.outerSize() + 1,
+            out.outerIndexPtr() + first);
+  std::copy(a.innerIndexPtr() + base, a.innerIndexPtr() + nnz, out.innerIndexPtr() + base);
+  std::copy(a.valuePtr() + base, a.valuePtr() + nnz, out.valuePtr() + base);
+}
+
 std::string format_residual(double r) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", r);
@@ -163,24 +181,45 @@ class CpuCgSolver final : public LinearSolver {
     const auto t0 = std::chrono::steady_clock::now();
     // The factor refactored ahead, of the last block (before that block is swapped away).
     std::unique_ptr<FramedCholesky> ahead = take_prefactor();
-    const Vector old_held_mask = held_mask_;
-    const Eigen::Index old_rows = a_.rows();
-    // The last factored block, kept (what the next frame is chosen against): swapped, not
-    // copied, and the arrays of the one before it are re-used for the new matrix.
-    SparseMatrix& previous = previous_;
-    previous.swap(any_held_ ? decoupled_ : a_);
     if (!held.empty() && static_cast<Eigen::Index>(held.size()) != a.rows())
       throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
                                   " entries for " + std::to_string(a.rows()) + " DOFs");
-    a_ = a;
+    const Vector old_held_mask = held_mask_;
+    const Eigen::Index old_rows = a_.rows();
+    const bool was_held = any_held_;
+    // The leading rows that are the last matrix's, bit for bit (History::changed_rows names
+    // every other row): on the hybrid matrix the dense interface block, most of its entries.
+    const std::optional<Eigen::Index> same_until = unchanged_leading_rows(a, history);
+    if (same_until) {
+      // Only the rows from there on are copied (the organ liver's whole matrix, ~290k entries:
+      // 0.6 ms a cut). The changed rows are known, so no frame is chosen by comparing blocks.
+      copy_rows_after(a, *same_until, a_);
+      previous_.resize(0, 0);
+    } else {
+      // The last block, kept (what the next frame is chosen against by comparison): swapped,
+      // not copied, and the arrays of the one before it are re-used for the new matrix.
+      previous_.swap(was_held ? decoupled_ : a_);
+      a_ = a;
+    }
     held_mask_ = Vector::Zero(a_.rows());
     for (size_t i = 0; i < held.size(); ++i)
       if (held[i]) held_mask_[static_cast<Eigen::Index>(i)] = 1;
     any_held_ = !held_mask_.isZero(0);
-    if (any_held_)
-      decoupled_of(a_, decoupled_);
-    else
+    if (any_held_) {
+      // D's rows before the first that A or the held set changed (a row whose DOF was held or
+      // let go, and its neighbours) are the last D's.
+      Eigen::Index d_same = same_until && was_held ? *same_until : 0;
+      for (Eigen::Index r = 0; r < d_same; ++r)  // d_same <= the old size
+        if (held_mask_[r] != old_held_mask[r]) {
+          const int row_start = a_.outerIndexPtr()[r];  // its lowest neighbour (sorted columns)
+          d_same = std::min(r, row_start < a_.outerIndexPtr()[r + 1]
+                                   ? static_cast<Eigen::Index>(a_.innerIndexPtr()[row_start])
+                                   : r);
+        }
+      decoupled_rows_after(a_, d_same, decoupled_);
+    } else {
       decoupled_.resize(0, 0);
+    }
     inv_diag_ = a_.diagonal();
     for (Eigen::Index i = 0; i < inv_diag_.size(); ++i)
       inv_diag_[i] = inv_diag_[i] != 0 ? 1.0 / inv_diag_[i] : 1.0;
@@ -212,7 +251,7 @@ class CpuCgSolver final : public LinearSolver {
     }
     if (history.expected_rows) expected = in_range(*history.expected_rows);
     if (wanted_ == CgPreconditioner::kCholesky) {
-      factor(same_rows, history.interface_rows, previous, changed, expected, std::move(ahead));
+      factor(same_rows, history.interface_rows, previous_, changed, expected, std::move(ahead));
     } else {
       chol_.reset();
       active_ = "jacobi";
@@ -382,27 +421,54 @@ class CpuCgSolver final : public LinearSolver {
   // The matrix to factor: A, or D with the held DOFs decoupled.
   const SparseMatrix& block() const { return any_held_ ? decoupled_ : a_; }
 
-  // D of `a` (held_mask_ set): the held rows and columns cleared but for the diagonal (1 where
-  // that is not positive).
-  // Written into `out`, whose arrays (the block before last, swapped out in set_matrix) are
-  // re-used: a new matrix every cut page-faulted in megabytes of fresh memory each time.
-  void decoupled_of(const SparseMatrix& a, SparseMatrix& out) const {
-    // Row by row: each row's columns stay sorted, so the compressed arrays are written
-    // directly (no triplets, no sort).
+  // The first row of `a` that may differ from the last matrix's (none: unknown): the lowest
+  // changed row, or the old size. Needs the rows to be the same DOFs (History::kept_rows).
+  std::optional<Eigen::Index> unchanged_leading_rows(const SparseMatrix& a,
+                                                     const History& history) const {
+    if (!history.changed_rows || a_.rows() == 0 || history.kept_rows < a_.rows() ||
+        a.rows() < a_.rows())
+      return std::nullopt;
+    Eigen::Index first = a_.rows();
+    for (int r : *history.changed_rows)
+      if (r >= 0) first = std::min(first, static_cast<Eigen::Index>(r));
+    return first;
+  }
+
+  // D of A (held_mask_ set): the held rows and columns cleared but for the diagonal (1 where
+  // that is not positive), written over `out`'s rows from `first` on (its rows before are D's
+  // already). Row by row: each row's columns stay sorted, so the compressed arrays are written
+  // directly (no triplets, no sort), into `out`'s arrays (a new matrix every cut page-faulted
+  // in megabytes of fresh memory each time).
+  void decoupled_rows_after(const SparseMatrix& a, Eigen::Index first, SparseMatrix& out) const {
     const Eigen::Index n = a.rows();
-    out.resize(n, n);
-    out.reserve(a.nonZeros() + n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      out.startVec(i);
+    if (first <= 0 || !out.isCompressed() || out.rows() < first) {
+      first = 0;
+      out.resize(n, n);
+    } else {
+      out.conservativeResize(n, n);
+    }
+    int k = out.outerIndexPtr()[first];
+    // At most A's entries of those rows and a diagonal each (1/8 more room for the next cuts).
+    out.data().resize(k + (a.nonZeros() - a.outerIndexPtr()[first]) + (n - first), 0.125);
+    int* outer = out.outerIndexPtr();
+    int* inner = out.innerIndexPtr();
+    double* value = out.valuePtr();
+    for (Eigen::Index i = first; i < n; ++i) {
+      outer[i] = k;
       if (held_mask_[i] != 0) {
-        const double d = a.coeff(i, i);
-        out.insertBack(i, i) = d > 0 ? d : 1.0;
+        double d = 0;
+        for (SparseMatrix::InnerIterator it(a, i); it; ++it)
+          if (it.index() == i) d = it.value();
+        inner[k] = static_cast<int>(i);
+        value[k++] = d > 0 ? d : 1.0;
         continue;
       }
       for (SparseMatrix::InnerIterator it(a, i); it; ++it)
-        if (held_mask_[it.index()] == 0) out.insertBack(i, it.index()) = it.value();
+        if (held_mask_[it.index()] == 0)
+          inner[k] = static_cast<int>(it.index()), value[k++] = it.value();
     }
-    out.finalize();
+    outer[n] = k;
+    out.data().resize(k);
   }
 
   // A (or D) itself, else it + kShift diag (a held free piece not named), else Jacobi stays
@@ -450,7 +516,7 @@ class CpuCgSolver final : public LinearSolver {
     const double refactor_flops = chol_ ? chol_->factor_flops() : 0;
     const int cap = max_frame(block.rows(), refactor_flops);
     std::vector<int> frame;
-    if (same_rows && previous.rows() > 0 && previous.rows() <= block.rows())
+    if (same_rows && (changed || (previous.rows() > 0 && previous.rows() <= block.rows())))
       frame = frame_for(block, previous, changed, dense, cap);
     else if (expected && !expected->empty())  // a fresh factor: frame where a cut is expected
       frame = FramedCholesky::frame_around(block, *expected, dense, 1);

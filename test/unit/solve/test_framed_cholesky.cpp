@@ -313,6 +313,109 @@ TEST(FramedCholesky, CpuSolverTakesAHeldDofThroughTheFrame) {
   }
 }
 
+// The CPU solver keeps its own copy of A (and of D when DOFs are held) and, told which rows a
+// change made (History::changed_rows), copies only the rows from the lowest of them on: after
+// changes low and high in the operation rows, a new DOF, a DOF held and a change while it is
+// held, each solve equals a fresh direct solve of the true matrix. A stale row in the copy
+// would solve another matrix.
+TEST(FramedCholesky, CpuSolverCopiesTheRowsAChangeNamesAndKeepsTheRest) {
+  for (const auto& [what, scene] :
+       {std::pair<std::string, Scene>{"thigh", make_thigh_scene()},
+        std::pair<std::string, Scene>{"TetGen liver", tetgen_liver()}}) {
+    SCOPED_TRACE(what);
+    const Framed f = framed_matrix(scene);
+    const int n = static_cast<int>(f.a.rows());
+    const int p = n - 1, q = f.outside, low = f.dense + 3;
+    ASSERT_GT(q, low);
+    // A spring between rows i and j (k (e_i - e_j)(e_i - e_j)^T): symmetric, keeps A SPD.
+    const auto spring = [](SparseMatrix a, int i, int j, double k) {
+      a.coeffRef(i, i) += k;
+      a.coeffRef(j, j) += k;
+      a.coeffRef(i, j) -= k;
+      a.coeffRef(j, i) -= k;
+      a.makeCompressed();
+      return a;
+    };
+    const double k = 0.3 * f.a.coeff(p, p);
+    auto solver = make_cpu_solver();
+    LinearSolver::History fresh;
+    fresh.interface_rows = f.dense;
+    solver->set_matrix(f.a, {}, fresh);
+    const auto expect_solves = [&](const SparseMatrix& a, const std::vector<std::uint8_t>& held,
+                                   const std::string& step) {
+      const int rows = static_cast<int>(a.rows());
+      const Vector b = Vector::LinSpaced(rows, 1.0, 2.0);
+      Vector x = Vector::Zero(rows);
+      for (int r = 0; r < rows; ++r)
+        if (!held.empty() && held[static_cast<size_t>(r)]) x[r] = 1e-3;
+      const CgResult res = solver->solve(b, x, held, CgSettings{1e-12, 50});
+      EXPECT_TRUE(res.converged) << step;
+      // One direct step: exact only with the factor of this matrix (of its D, DOFs held).
+      EXPECT_EQ(res.iterations, 1) << step << ": the factor is not of this matrix";
+      Vector residual = b - a * x;
+      for (int r = 0; r < rows; ++r)
+        if (!held.empty() && held[static_cast<size_t>(r)]) {
+          EXPECT_EQ(x[r], 1e-3) << step;
+          residual[r] = 0;
+        }
+      EXPECT_LE(residual.norm() / b.norm(), 1e-11) << step << ": the copy is not the matrix";
+    };
+    LinearSolver::History cut;
+    cut.kept_rows = n;
+    cut.interface_rows = f.dense;
+    // 1. Values alone (the same pattern): a spring between p and a neighbour, and row low's
+    // diagonal; then a new coupling between rows far apart.
+    const int j = [&] {
+      for (SparseMatrix::InnerIterator it(f.a, p); it; ++it)
+        if (it.index() != p && it.index() >= f.dense) return static_cast<int>(it.index());
+      return -1;
+    }();
+    ASSERT_GE(j, 0);
+    SparseMatrix a0 = spring(f.a, p, j, k);
+    a0.coeffRef(low, low) *= 1.25;
+    ASSERT_EQ(a0.nonZeros(), f.a.nonZeros());
+    const std::vector<int> rows0 = {p, j, low};
+    cut.changed_rows = &rows0;
+    solver->set_matrix(a0, {}, cut);
+    expect_solves(a0, {}, "values of rows p, j and low");
+    const SparseMatrix a1 = spring(a0, p, q, k);
+    const std::vector<int> rows1 = {q, p};
+    cut.changed_rows = &rows1;
+    solver->set_matrix(a1, {}, cut);
+    expect_solves(a1, {}, "a change of rows q and p");
+    // 2. A new DOF coupled to p (a cut appends its new nodes' DOFs).
+    SparseMatrix a2 = a1;
+    a2.conservativeResize(n + 1, n + 1);
+    a2 = spring(a2, p, n, k);
+    const std::vector<int> rows2 = {p, n};
+    cut.changed_rows = &rows2;
+    solver->set_matrix(a2, {}, cut);
+    expect_solves(a2, {}, "a new DOF");
+    // 3. The same matrix, q held: D's rows change from q's lowest neighbour on.
+    std::vector<std::uint8_t> held(static_cast<size_t>(n + 1), 0);
+    held[static_cast<size_t>(q)] = 1;
+    const std::vector<int> none;
+    cut.kept_rows = n + 1;
+    cut.changed_rows = &none;
+    solver->set_matrix(a2, held, cut);
+    expect_solves(a2, held, "q held");
+    // 4. While q is held, a change low in the operation rows (D rewritten from there on).
+    const SparseMatrix a3 = spring(a2, low, p, k);
+    const std::vector<int> rows3 = {p, low};
+    cut.changed_rows = &rows3;
+    solver->set_matrix(a3, held, cut);
+    expect_solves(a3, held, "a low row while q is held");
+    // 5. j held as well (the held set changes while D exists; the matrix does not).
+    held[static_cast<size_t>(j)] = 1;
+    cut.changed_rows = &none;
+    solver->set_matrix(a3, held, cut);
+    expect_solves(a3, held, "j held too");
+    // 6. Let go of both, no other change.
+    solver->set_matrix(a3, {}, cut);
+    expect_solves(a3, {}, "q let go");
+  }
+}
+
 // Rows outside the frame join it as extra rows, one change after another, and new DOFs may
 // couple to them; each time the factor solves the new matrix as exactly as a fresh one.
 TEST(FramedCholesky, TakesAFewRowsOutsideTheFrameOneChangeAfterAnother) {
