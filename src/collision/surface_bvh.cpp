@@ -63,6 +63,39 @@ void SurfaceBvh::build(BoundarySurface surface, const TetMesh& mesh,
                        const std::vector<std::uint8_t>& operation_tets,
                        const std::vector<Vec3>& displacement) {
   surface_ = std::move(surface);
+  index_surface(mesh, operation_tets, displacement);
+}
+
+void SurfaceBvh::rebuild_after(size_t kept, BoundarySurface tail, const TetMesh& mesh,
+                               const std::vector<std::uint8_t>& operation_tets,
+                               const std::vector<Vec3>& displacement) {
+  // The other tree is exactly triangles 0 .. kept-1 (listed in increasing order) and indexed.
+  const bool fits = kept <= surface_.triangles.size() && other_triangles_.size() == kept &&
+                    (kept == 0 || other_triangles_.back() == static_cast<int>(kept) - 1) &&
+                    other_tree_.size() == static_cast<int>(kept) && other_nodes_.size() == kept;
+  surface_.triangles.resize(std::min(kept, surface_.triangles.size()));
+  surface_.triangles.insert(surface_.triangles.end(), tail.triangles.begin(), tail.triangles.end());
+  surface_.non_manifold_faces = tail.non_manifold_faces;
+  bool operation_only = true;
+  for (const BoundaryTriangle& t : tail.triangles)
+    operation_only = operation_only && (operation_tets.empty() || operation_tets[t.tet]);
+  if (!fits || !operation_only) {
+    index_surface(mesh, operation_tets, displacement);
+    return;
+  }
+  const size_t n = surface_.triangles.size();
+  operation_.assign(n, 1);
+  std::fill(operation_.begin(), operation_.begin() + static_cast<std::ptrdiff_t>(kept), 0);
+  operation_triangles_.resize(n - kept);
+  for (size_t i = kept; i < n; ++i) operation_triangles_[i - kept] = static_cast<int>(i);
+  const size_t known = positions_.size();
+  const std::vector<int> moved = place_nodes(mesh, per_node(mesh, displacement));
+  operation_tree_.build(triangle_boxes(operation_triangles_));
+  refit_other_tree(moved, known);
+}
+
+void SurfaceBvh::index_surface(const TetMesh& mesh, const std::vector<std::uint8_t>& operation_tets,
+                               const std::vector<Vec3>& displacement) {
   operation_.resize(surface_.triangles.size());
   operation_triangles_.clear();
   other_triangles_.clear();

@@ -1,6 +1,7 @@
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
 
 #include <algorithm>
+#include <atomic>
 
 namespace stc {
 namespace {
@@ -48,6 +49,8 @@ void OperationSurface::init(const TetMesh& mesh, const std::vector<std::uint8_t>
       shared_.push_back(key(t.nodes));
   std::sort(shared_.begin(), shared_.end());
   condensed_non_manifold_ = std::max(0, full.non_manifold_faces - own.non_manifold_faces);
+  static std::atomic<long> extractions{0};  // a moved region's surface is made on its worker
+  extraction_ = ++extractions;
 }
 
 void OperationSurface::update(const TetMesh& mesh, const std::vector<int>& changed) {
@@ -55,9 +58,15 @@ void OperationSurface::update(const TetMesh& mesh, const std::vector<int>& chang
 }
 
 BoundarySurface OperationSurface::current(const TetMesh& mesh) const {
+  BoundarySurface s = operation_part(mesh);
+  s.triangles.insert(s.triangles.begin(), condensed_.begin(), condensed_.end());
+  return s;
+}
+
+BoundarySurface OperationSurface::operation_part(const TetMesh& mesh) const {
   BoundarySurface s;
-  s.triangles = condensed_;
   const BoundarySurface own = part1_.boundary(mesh);
+  s.triangles.reserve(own.triangles.size());
   for (const BoundaryTriangle& t : own.triangles)
     if (!std::binary_search(shared_.begin(), shared_.end(), key(t.nodes))) s.triangles.push_back(t);
   s.non_manifold_faces = condensed_non_manifold_ + own.non_manifold_faces;

@@ -76,7 +76,8 @@ struct Simulation::Impl {
   // The current boundary surface at deformed positions in an AABB tree: rebuilt after cuts,
   // refit before each contact query, so a step never scans the whole surface.
   SurfaceBvh surface_tree;
-  OperationSurface boundary;  // the boundary after cuts from part 1 alone
+  OperationSurface boundary;         // the boundary after cuts from part 1 alone
+  long surface_tree_extraction = 0;  // boundary.extraction() surface_tree was last built from
   // `follow`: which tets of the whole mesh share each face, kept across cuts and moves (a move
   // changes the partition, not the mesh), so the free-piece search after a cut matches only
   // the faces the cut changed (docs/DESIGN.md section 10a, "Free pieces").
@@ -189,6 +190,7 @@ struct Simulation::Impl {
       mesh_faces.track_cut_off(true);  // pieces_a_cut_may_free
     }
     surface_tree.build(model->mesh(), model->partition().operation_tet, displacements());
+    surface_tree_extraction = 0;  // not from `boundary`
     ++surface_version;
     ++mesh_version;
   }
@@ -395,10 +397,17 @@ struct Simulation::Impl {
   }
 
   // The operation surface of the current mesh and partition, at the current displacement.
+  // The part-2 triangles come first and stay the same from one extraction of `boundary` to the
+  // next (a cut changes part 1 alone): after a cut the tree takes the operation part's anew.
   void rebuild_surface_tree() {
     const Partition& p = model->partition();
-    surface_tree.build(boundary.current(model->mesh()), model->mesh(), p.operation_tet,
-                       displacements());
+    if (surface_tree_extraction != 0 && surface_tree_extraction == boundary.extraction())
+      surface_tree.rebuild_after(boundary.condensed_count(), boundary.operation_part(model->mesh()),
+                                 model->mesh(), p.operation_tet, displacements());
+    else
+      surface_tree.build(boundary.current(model->mesh()), model->mesh(), p.operation_tet,
+                         displacements());
+    surface_tree_extraction = boundary.extraction();
   }
 
   // docs/SCENE.md "Cut invariants": a piece severed from everything anchored is kept and held where

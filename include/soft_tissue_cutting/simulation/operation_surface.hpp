@@ -23,6 +23,12 @@ class OperationSurface {
   // The whole boundary surface now (same triangles as extract_boundary_surface(mesh), part-2
   // triangles first).
   BoundarySurface current(const TetMesh& mesh) const;
+  // Its part-2 triangles, the leading condensed_count() of current(), are the same from one
+  // init to the next: which one this is (unique among all OperationSurfaces), their count, and
+  // the triangles after them (non_manifold_faces: the whole surface's).
+  long extraction() const { return extraction_; }
+  size_t condensed_count() const { return condensed_.size(); }
+  BoundarySurface operation_part(const TetMesh& mesh) const;
   // Part 1's face-connected pieces (as face_connected_pieces of the part-1 tets alone).
   std::vector<MeshPiece> part1_pieces(const TetMesh& mesh) const { return part1_.pieces(mesh); }
 
@@ -32,6 +38,7 @@ class OperationSurface {
   std::vector<BoundaryTriangle> condensed_;  // boundary triangles owned by part-2 tets
   std::vector<std::array<int, 3>> shared_;   // sorted node triples of part 1 / part 2 faces
   int condensed_non_manifold_ = 0;
+  long extraction_ = 0;  // 0: never extracted
 };
 
 // The tets of `tets` as a mesh of their own (same node numbering and rest positions, cut flags

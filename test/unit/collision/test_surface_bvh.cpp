@@ -65,6 +65,81 @@ TEST(CollisionBvh, PointInTissueByRayParity) {
 // point-in-tissue answers equal one tree's over every triangle - after a build, after a refit
 // on moved nodes, and after a second build that keeps the other triangles' tree (their set
 // unchanged): the path every cut takes.
+// A cut's rebuild from the operation part alone (rebuild_after: the other tree's leading
+// triangles kept, neither copied nor compared) answers exactly as a build of the whole surface
+// does: same triangles, same operation flags, same candidates, same inside answers. A tail with
+// a triangle that is not the operation part's is indexed whole, as a build.
+TEST(CollisionBvh, RebuildAfterTheKeptTrianglesAnswersLikeABuild) {
+  const Scene scene = make_thigh_scene();
+  std::vector<std::uint8_t> operation(scene.mesh.tets.size(), 0);
+  for (size_t t = 0; t < scene.mesh.tets.size(); ++t) {
+    Vec3 c = Vec3::Zero();
+    for (int v : scene.mesh.tets[t]) c += 0.25 * scene.mesh.nodes[v];
+    operation[t] = c.x() > 0.03;
+  }
+  BoundarySurface others, tail;
+  for (const BoundaryTriangle& t : extract_boundary_surface(scene.mesh).triangles)
+    (operation[t.tet] ? tail : others).triangles.push_back(t);
+  const size_t kept = others.triangles.size();
+  ASSERT_GT(kept, 0u);
+  ASSERT_GT(tail.triangles.size(), 10u);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-0.07, 0.07), z(-0.01, 0.106), small(-2e-3, 2e-3);
+  std::vector<Vec3> moved(scene.mesh.nodes.size());
+  for (Vec3& d : moved) d = Vec3(small(rng), small(rng), small(rng));
+  const auto whole = [&](const BoundarySurface& t) {
+    BoundarySurface s = others;
+    s.triangles.insert(s.triangles.end(), t.triangles.begin(), t.triangles.end());
+    return s;
+  };
+  SurfaceBvh fast;
+  fast.build(whole(tail), scene.mesh, operation, {});
+  // The operation part changed: some triangles gone, the rest in another order; nodes moved.
+  BoundarySurface changed;
+  changed.triangles.assign(tail.triangles.rbegin(), tail.triangles.rend() - 7);
+  const auto same_as_build = [&](const BoundarySurface& t, const char* when) {
+    fast.rebuild_after(kept, t, scene.mesh, operation, moved);
+    SurfaceBvh ref;
+    ref.build(whole(t), scene.mesh, operation, moved);
+    ASSERT_EQ(fast.surface().triangles.size(), ref.surface().triangles.size()) << when;
+    for (size_t i = 0; i < ref.surface().triangles.size(); ++i) {
+      ASSERT_EQ(fast.surface().triangles[i].nodes, ref.surface().triangles[i].nodes) << when;
+      ASSERT_EQ(fast.is_operation(static_cast<int>(i)), ref.is_operation(static_cast<int>(i)))
+          << when << ", triangle " << i;
+    }
+    for (int trial = 0; trial < 300; ++trial) {
+      const Vec3 a(u(rng), u(rng), z(rng)), b = a + Vec3(small(rng), small(rng), small(rng)) * 10;
+      // Candidates: every triangle whose deformed box meets the segment's (the trees may add
+      // more: their leaves' shapes differ between a refit and a fresh build).
+      std::vector<int> x = fast.near_segment(a, b, 1e-3);
+      std::sort(x.begin(), x.end());
+      Box3 query(a);
+      query.extend(b);
+      query.min().array() -= 1e-3;
+      query.max().array() += 1e-3;
+      for (size_t i = 0; i < ref.surface().triangles.size(); ++i) {
+        const Tri& n = ref.surface().triangles[i].nodes;
+        ASSERT_EQ(fast.position(n[0]), ref.position(n[0])) << when;
+        Box3 box(ref.position(n[0]));
+        box.extend(ref.position(n[1]));
+        box.extend(ref.position(n[2]));
+        if (box.intersects(query)) {
+          ASSERT_TRUE(std::binary_search(x.begin(), x.end(), static_cast<int>(i)))
+              << when << ", triangle " << i << " missing for segment " << a.transpose();
+        }
+      }
+      ASSERT_EQ(fast.contains(a), ref.contains(a)) << when << ", point " << a.transpose();
+    }
+  };
+  same_as_build(changed, "the operation part rebuilt");
+  for (Vec3& d : moved) d += Vec3(small(rng), small(rng), small(rng));
+  same_as_build(tail, "rebuilt again after the nodes moved");
+  BoundarySurface with_other = changed;
+  with_other.triangles.push_back(others.triangles.front());  // not the operation part's
+  same_as_build(with_other, "a tail triangle of the other part");
+  same_as_build(changed, "after the whole indexing");
+}
+
 TEST(CollisionBvh, OperationAndOtherTreesAnswerLikeOneTree) {
   const Scene scene = make_thigh_scene();
   std::vector<std::uint8_t> operation(scene.mesh.tets.size(), 0);
