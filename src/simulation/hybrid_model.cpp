@@ -404,12 +404,10 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
   elements_.update(mesh_, changed_tets);
   // Only part 1 changed: the partition is updated from the part-1 tets alone. The condensed
   // part must be untouched: same I, S, Q and part-2 tets.
-  Partition p = partition_;
-  if (!update_partition_for_operation_change(mesh_, changed_tets, p))
+  if (!update_partition_for_operation_change(mesh_, changed_tets, partition_))
     throw std::logic_error(
         "HybridModel::update_operation_part: the change reached the "
         "condensed (non-operation) part");
-  partition_ = std::move(p);
   rebuild_hybrid_system(&changed_tets, &removed);
 }
 

@@ -40,7 +40,7 @@ Partition partition_from_labels(const TetMesh& mesh, std::vector<std::uint8_t> o
 // or appended) become part-1 tets, appended nodes join O. Part 2 is untouched, so S and Q
 // stay as they are and only the part-1 tets are scanned (no boundary extraction of the whole
 // mesh). Returns false if the change reached part 2 (a changed tet was a part-2 tet, or an
-// interface node stopped being shared): the caller refuses the change.
+// interface node stopped being shared): the caller refuses the change, and p is as it was.
 bool update_partition_for_operation_change(const TetMesh& mesh,
                                            const std::vector<int>& changed_tets, Partition& p);
 

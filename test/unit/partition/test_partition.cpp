@@ -135,6 +135,21 @@ TEST(Partition, OperationChangeAppendsToPartOneAndRefusesToReachPartTwo) {
   Partition refused = before;
   EXPECT_FALSE(
       update_partition_for_operation_change(mesh, {before.condensed_tets.front()}, refused));
+  // ... and leaves the partition as it was (the model updates its own in place).
+  EXPECT_EQ(refused.operation_tet, before.operation_tet);
+  EXPECT_EQ(refused.node_set, before.node_set);
+  EXPECT_EQ(refused.operation, before.operation);
+  EXPECT_EQ(refused.operation_tets, before.operation_tets);
+  // A part-1 tet rewritten onto a node of S (the change reaches part 2): refused, unchanged.
+  Partition onto_surface = p;
+  const Partition kept = onto_surface;
+  TetMesh reaching = mesh;
+  reaching.tets[static_cast<size_t>(t0)][0] = before.surface.front();
+  EXPECT_FALSE(update_partition_for_operation_change(reaching, {t0}, onto_surface));
+  EXPECT_EQ(onto_surface.operation_tet, kept.operation_tet);
+  EXPECT_EQ(onto_surface.node_set, kept.node_set);
+  EXPECT_EQ(onto_surface.operation, kept.operation);
+  EXPECT_EQ(onto_surface.operation_tets, kept.operation_tets);
 }
 
 }  // namespace
