@@ -14,6 +14,30 @@ namespace {
 
 using test::cube_mesh;
 
+// Every triangle whose deformed box meets segment [a, b]'s box padded by `margin` is among
+// bvh.near_segment's candidates (the trees may add more: a refitted tree's leaves differ from
+// a fresh build's).
+::testing::AssertionResult box_candidates_found(const SurfaceBvh& bvh, const Vec3& a, const Vec3& b,
+                                                double margin) {
+  std::vector<int> found = bvh.near_segment(a, b, margin);
+  std::sort(found.begin(), found.end());
+  Box3 query(a);
+  query.extend(b);
+  query.min().array() -= margin;
+  query.max().array() += margin;
+  for (size_t t = 0; t < bvh.surface().triangles.size(); ++t) {
+    const Tri& n = bvh.surface().triangles[t].nodes;
+    Box3 box(bvh.position(n[0]));
+    box.extend(bvh.position(n[1]));
+    box.extend(bvh.position(n[2]));
+    if (box.intersects(query) &&
+        !std::binary_search(found.begin(), found.end(), static_cast<int>(t)))
+      return ::testing::AssertionFailure()
+             << "triangle " << t << " missing for segment " << a.transpose();
+  }
+  return ::testing::AssertionSuccess();
+}
+
 TEST(CollisionBvh, SegmentCandidatesMatchBruteForceOnTheDeformedThigh) {
   const Scene scene = make_thigh_scene();
   std::mt19937 rng(5);
@@ -103,31 +127,15 @@ TEST(CollisionBvh, RebuildAfterTheKeptTrianglesAnswersLikeABuild) {
     ref.build(whole(t), scene.mesh, operation, moved);
     ASSERT_EQ(fast.surface().triangles.size(), ref.surface().triangles.size()) << when;
     for (size_t i = 0; i < ref.surface().triangles.size(); ++i) {
-      ASSERT_EQ(fast.surface().triangles[i].nodes, ref.surface().triangles[i].nodes) << when;
+      const Tri& n = ref.surface().triangles[i].nodes;
+      ASSERT_EQ(fast.surface().triangles[i].nodes, n) << when;
       ASSERT_EQ(fast.is_operation(static_cast<int>(i)), ref.is_operation(static_cast<int>(i)))
           << when << ", triangle " << i;
+      for (int v : n) ASSERT_EQ(fast.position(v), ref.position(v)) << when;
     }
     for (int trial = 0; trial < 300; ++trial) {
       const Vec3 a(u(rng), u(rng), z(rng)), b = a + Vec3(small(rng), small(rng), small(rng)) * 10;
-      // Candidates: every triangle whose deformed box meets the segment's (the trees may add
-      // more: their leaves' shapes differ between a refit and a fresh build).
-      std::vector<int> x = fast.near_segment(a, b, 1e-3);
-      std::sort(x.begin(), x.end());
-      Box3 query(a);
-      query.extend(b);
-      query.min().array() -= 1e-3;
-      query.max().array() += 1e-3;
-      for (size_t i = 0; i < ref.surface().triangles.size(); ++i) {
-        const Tri& n = ref.surface().triangles[i].nodes;
-        ASSERT_EQ(fast.position(n[0]), ref.position(n[0])) << when;
-        Box3 box(ref.position(n[0]));
-        box.extend(ref.position(n[1]));
-        box.extend(ref.position(n[2]));
-        if (box.intersects(query)) {
-          ASSERT_TRUE(std::binary_search(x.begin(), x.end(), static_cast<int>(i)))
-              << when << ", triangle " << i << " missing for segment " << a.transpose();
-        }
-      }
+      ASSERT_TRUE(box_candidates_found(fast, a, b, 1e-3)) << when;
       ASSERT_EQ(fast.contains(a), ref.contains(a)) << when << ", point " << a.transpose();
     }
   };
@@ -163,22 +171,7 @@ TEST(CollisionBvh, OperationAndOtherTreesAnswerLikeOneTree) {
   auto same_answers = [&](const char* when) {
     for (int trial = 0; trial < 300; ++trial) {
       const Vec3 a(u(rng), u(rng), z(rng)), b = a + Vec3(small(rng), small(rng), small(rng)) * 10;
-      std::vector<int> x = split.near_segment(a, b, 1e-3);
-      std::sort(x.begin(), x.end());
-      Box3 query(a);
-      query.extend(b);
-      query.min().array() -= 1e-3;
-      query.max().array() += 1e-3;
-      for (size_t t = 0; t < split.surface().triangles.size(); ++t) {
-        const Tri& n = split.surface().triangles[t].nodes;
-        Box3 box(split.position(n[0]));
-        box.extend(split.position(n[1]));
-        box.extend(split.position(n[2]));
-        if (box.intersects(query)) {
-          ASSERT_TRUE(std::binary_search(x.begin(), x.end(), static_cast<int>(t)))
-              << when << ", triangle " << t << " missing for segment " << a.transpose();
-        }
-      }
+      ASSERT_TRUE(box_candidates_found(split, a, b, 1e-3)) << when;
       ASSERT_EQ(split.contains(a), one.contains(a)) << when << ", point " << a.transpose();
     }
   };

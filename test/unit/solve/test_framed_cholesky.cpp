@@ -17,6 +17,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace stc {
 namespace {
@@ -136,6 +138,20 @@ Framed framed_matrix(const Scene& scene) {
 
 Framed thigh_matrix() { return framed_matrix(make_thigh_scene()); }
 
+// The built-in thigh and the TetGen liver, named, for tests that run on both.
+std::vector<std::pair<std::string, Scene>> thigh_and_tetgen_liver() {
+  return {{"thigh", make_thigh_scene()}, {"TetGen liver", tetgen_liver()}};
+}
+
+// A factorization's history: the interface rows only (a fresh one), optionally where the next
+// change is expected.
+LinearSolver::History fresh_history(const Framed& f, const std::vector<int>* expected = nullptr) {
+  LinearSolver::History h;
+  h.interface_rows = f.dense;
+  h.expected_rows = expected;
+  return h;
+}
+
 TEST(FramedCholesky, FrameAroundChangesIsTheChangedRowsAndTheirNeighbours) {
   const Framed f = thigh_matrix();
   const int last = static_cast<int>(f.a.rows()) - 1;
@@ -250,10 +266,7 @@ TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
   const Vector ref = SparseCholesky(changed).solve(b);
   for (const bool hint : {true, false}) {
     auto solver = make_cpu_solver();
-    LinearSolver::History fresh;
-    fresh.interface_rows = f.dense;
-    if (hint) fresh.expected_rows = &expected;
-    solver->set_matrix(f.a, {}, fresh);
+    solver->set_matrix(f.a, {}, fresh_history(f, hint ? &expected : nullptr));
     LinearSolver::History cut;
     cut.kept_rows = n;
     cut.interface_rows = f.dense;
@@ -271,19 +284,14 @@ TEST(FramedCholesky, CpuSolverFramesTheRowsWhereAChangeIsExpected) {
 // (cpu_cg_solver.cpp): its row and its neighbours' change, which the frame takes like a cut's
 // rows. The held DOF keeps its value exactly; the others solve A_ff x_f = b_f - A_fh x_h.
 TEST(FramedCholesky, CpuSolverTakesAHeldDofThroughTheFrame) {
-  for (const auto& [what, scene] :
-       {std::pair<std::string, Scene>{"thigh", make_thigh_scene()},
-        std::pair<std::string, Scene>{"TetGen liver", tetgen_liver()}}) {
+  for (const auto& [what, scene] : thigh_and_tetgen_liver()) {
     SCOPED_TRACE(what);
     const Framed f = framed_matrix(scene);
     const int n = static_cast<int>(f.a.rows());
     const int p = n - 1;  // f.frame: p and its neighbours, what holding p changes in D
     const Vector b = Vector::LinSpaced(n, 1.0, 2.0);
     auto solver = make_cpu_solver();
-    LinearSolver::History fresh;
-    fresh.interface_rows = f.dense;
-    fresh.expected_rows = &f.frame;  // framed with one ring more
-    solver->set_matrix(f.a, {}, fresh);
+    solver->set_matrix(f.a, {}, fresh_history(f, &f.frame));  // framed with one ring more
     const std::vector<int> none;
     LinearSolver::History same;
     same.kept_rows = n;
@@ -319,9 +327,7 @@ TEST(FramedCholesky, CpuSolverTakesAHeldDofThroughTheFrame) {
 // held, each solve equals a fresh direct solve of the true matrix. A stale row in the copy
 // would solve another matrix.
 TEST(FramedCholesky, CpuSolverCopiesTheRowsAChangeNamesAndKeepsTheRest) {
-  for (const auto& [what, scene] :
-       {std::pair<std::string, Scene>{"thigh", make_thigh_scene()},
-        std::pair<std::string, Scene>{"TetGen liver", tetgen_liver()}}) {
+  for (const auto& [what, scene] : thigh_and_tetgen_liver()) {
     SCOPED_TRACE(what);
     const Framed f = framed_matrix(scene);
     const int n = static_cast<int>(f.a.rows());
@@ -338,9 +344,7 @@ TEST(FramedCholesky, CpuSolverCopiesTheRowsAChangeNamesAndKeepsTheRest) {
     };
     const double k = 0.3 * f.a.coeff(p, p);
     auto solver = make_cpu_solver();
-    LinearSolver::History fresh;
-    fresh.interface_rows = f.dense;
-    solver->set_matrix(f.a, {}, fresh);
+    solver->set_matrix(f.a, {}, fresh_history(f));
     const auto expect_solves = [&](const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                                    const std::string& step) {
       const int rows = static_cast<int>(a.rows());
