@@ -63,8 +63,10 @@ int main(int argc, char** argv) {
     options.log = [](stc::LogLevel, const std::string& message) {
       std::fprintf(stderr, "tissue solve: %s\n", message.c_str());
     };
-    // A `follow` region's moves are awaited offline (no real time to keep): deterministic.
+    // A `follow` region's moves and a factor refactored ahead are awaited offline (no real
+    // time to keep): deterministic.
     options.wait_for_region_moves = true;
+    options.wait_for_factor_ahead = true;
     stc::Simulation sim(stc::load_scene(scene_path), options);
     if (!sim.backend_note().empty())
       std::fprintf(stderr, "tissue solve: %s\n", sim.backend_note().c_str());

@@ -210,6 +210,7 @@ void HybridModel::refresh_factor() const {
           expected_rows.push_back(r);
   expected_cut_nodes_.clear();
   if (!expected_rows.empty()) history.expected_rows = &expected_rows;
+  history.await_factor_ahead = settings_.await_factor_ahead;
   solver_->set_matrix(a_, held_dofs(), history);
   solver_dofs_ = now;
   rows_changed_.emplace();  // from here on, every change is listed (update_hybrid_matrix)

@@ -142,7 +142,8 @@ struct Simulation::Impl {
     scene = initial;
     refuse_floating_pieces();
     model = std::make_unique<HybridModel>(scene, make_solver());
-    model->set_cg_settings(CgSettings{scene.solver.tolerance, scene.solver.max_iterations});
+    model->set_cg_settings(CgSettings{scene.solver.tolerance, scene.solver.max_iterations,
+                                      options.wait_for_factor_ahead});
     // Only the operation part is cut; interface nodes stay whole so K0/R stay valid.
     const Partition& p = model->partition();
     std::vector<std::uint8_t> locked(static_cast<size_t>(model->mesh().num_nodes()), 0);

@@ -54,6 +54,7 @@
 #include <cstdio>
 #include <future>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -159,6 +160,7 @@ class CpuCgSolver final : public LinearSolver {
   std::string preconditioner() const override { return active_; }
   double setup_ms() const override { return setup_ms_; }
   int frame_updates() const override { return frame_updates_; }
+  int factors_taken_ahead() const override { return taken_ahead_; }
   // Found on demand (one more factorization), so a cut whose first factor fails only until
   // its free pieces are held pays nothing for it.
   int singular_dof() const override {
@@ -179,8 +181,15 @@ class CpuCgSolver final : public LinearSolver {
   void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                   const History& history) override {
     const auto t0 = std::chrono::steady_clock::now();
-    // The factor refactored ahead, of the last block (before that block is swapped away).
-    std::unique_ptr<FramedCholesky> ahead = take_prefactor();
+    // The thread refactoring ahead copies the block it factors first (long done by now, a
+    // step later): the block may change below.
+    if (prefactor_copied_.valid()) prefactor_copied_.wait();
+    // The factor refactored ahead of an earlier block: awaited, or (online) taken if ready.
+    std::unique_ptr<FramedCholesky> ahead;
+    if (prefactor_.valid() &&
+        (history.await_factor_ahead ||
+         prefactor_.wait_for(std::chrono::seconds(0)) == std::future_status::ready))
+      ahead = take_prefactor();
     if (!held.empty() && static_cast<Eigen::Index>(held.size()) != a.rows())
       throw std::invalid_argument("set_matrix: held has " + std::to_string(held.size()) +
                                   " entries for " + std::to_string(a.rows()) + " DOFs");
@@ -250,6 +259,14 @@ class CpuCgSolver final : public LinearSolver {
             changed->push_back(static_cast<int>(it.index()));
     }
     if (history.expected_rows) expected = in_range(*history.expected_rows);
+    // The rows changed since the block the factor ahead was made of: this change's and those
+    // of the changes made while it ran (unknown, or other DOFs: it cannot take this block).
+    if (ahead || prefactor_.valid()) {
+      if (changed && ahead_changed_)
+        ahead_changed_->insert(ahead_changed_->end(), changed->begin(), changed->end());
+      else
+        ahead_changed_.reset();
+    }
     if (wanted_ == CgPreconditioner::kCholesky) {
       factor(same_rows, history.interface_rows, previous_, changed, expected, std::move(ahead));
     } else {
@@ -476,7 +493,8 @@ class CpuCgSolver final : public LinearSolver {
   // may take it by refactoring its frame (docs/DESIGN.md section 6.2), and else the new factor
   // keeps a frame around what changed since `previous` (the last block); its first `interface`
   // rows are the dense interface block.
-  // ahead: the last block's factor refactored ahead (kPrefactorShare), if one was.
+  // ahead: an earlier block's factor refactored ahead (kPrefactorShare), if one was and is
+  // ready; ahead_changed_ lists the rows changed since that block.
   void factor(bool same_rows, int interface, const SparseMatrix& previous,
               const std::optional<std::vector<int>>& changed,
               const std::optional<std::vector<int>>& expected,
@@ -488,14 +506,19 @@ class CpuCgSolver final : public LinearSolver {
       return;
     }
     const int dense = interface;  // the interface block's rows (D's rows are A's)
-    // The factor refactored ahead differs from this block in this change's rows alone.
-    if (ahead && same_rows && changed && active_ == "cholesky" &&
-        ahead->update(block, &*changed, update_limit(block.rows(), ahead->factor_flops()))) {
-      chol_ = std::move(ahead);
-      changed_since_factor_ = *changed;
+    // The factor refactored ahead differs from this block in the rows changed since its own.
+    const auto take_ahead = [&](std::unique_ptr<FramedCholesky> f) {
+      if (!f || !same_rows || !ahead_changed_ || active_ != "cholesky" ||
+          !f->update(block, &*ahead_changed_, update_limit(block.rows(), f->factor_flops())))
+        return false;
+      chol_ = std::move(f);
+      changed_since_factor_ = std::move(ahead_changed_);
+      ahead_changed_.reset();
       ++frame_updates_;
-      return;
-    }
+      ++taken_ahead_;
+      return true;
+    };
+    if (take_ahead(std::move(ahead))) return;
     // Every row changed since the factorization: this change's, and the earlier updates'.
     if (changed && changed_since_factor_)
       changed_since_factor_->insert(changed_since_factor_->end(), changed->begin(), changed->end());
@@ -506,12 +529,19 @@ class CpuCgSolver final : public LinearSolver {
       if (chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr,
                         update_limit(block.rows(), chol_->factor_flops()))) {
         ++frame_updates_;
-        if (changed && chol_->frame_size() > kPrefactorShare * cap &&
+        // Refactored ahead when the frame or its extra rows fill up (a fresh factor with a
+        // small frame, a moved region's, meets the extra-row limit long before the cap).
+        const bool filling = chol_->frame_size() > kPrefactorShare * cap ||
+                             chol_->extra_rows() > kPrefactorShare * FramedCholesky::kMaxExtraRows;
+        if (changed && !prefactor_.valid() && filling &&
             refactor_is_dear(block.rows(), chol_->factor_flops()))
           prefactor(frame_for(block, previous, changed, dense, cap));
         return;
       }
     }
+    // The grown frame is full: the factor still being refactored ahead is awaited now (what
+    // is left of it costs less than a refactorization here).
+    if (prefactor_.valid() && take_ahead(take_prefactor())) return;
     // The last factorization's cost stands for this one's (the block changed by one cut).
     const double refactor_flops = chol_ ? chol_->factor_flops() : 0;
     const int cap = max_frame(block.rows(), refactor_flops);
@@ -560,29 +590,41 @@ class CpuCgSolver final : public LinearSolver {
     return frame;
   }
 
-  // Refactors the present block with `frame` on a second thread (it reads block() until
-  // take_prefactor, which the next set_matrix calls first).
+  // Refactors the present block with `frame` on a second thread. The thread copies the block
+  // first (prefactor_copied_, which the next set_matrix awaits before it changes the block),
+  // and the factor keeps that copy.
   void prefactor(std::vector<int> frame) {
     if (frame.empty()) return;
     const SparseMatrix& block = this->block();
+    auto copied = std::make_shared<std::promise<void>>();
     try {
-      prefactor_ = std::async(std::launch::async, [&block, frame = std::move(frame)]() {
+      prefactor_copied_ = copied->get_future();
+      prefactor_ = std::async(std::launch::async, [&block, copied, frame = std::move(frame)]() {
         settle_openmp_on_this_thread();  // CHOLMOD at full speed on this thread (blas_guard.hpp)
         std::unique_ptr<FramedCholesky> f;
+        bool told = false;
         try {
-          f = std::make_unique<FramedCholesky>(block, frame);
+          SparseMatrix own = block;
+          copied->set_value();
+          told = true;
+          f = std::make_unique<FramedCholesky>(std::move(own), frame);
         } catch (const std::exception&) {  // not positive definite, out of memory: the loop's
         }                                  // own refactorization meets it and says so
+        if (!told) copied->set_value();
         return f;
       });
+      ahead_changed_.emplace();           // the factor ahead is of this block
     } catch (const std::system_error&) {  // no thread to be had: the loop refactors when due
+      prefactor_copied_ = {};
     }
   }
 
-  // The factor refactored ahead, waiting for it (null if none was started or it failed): one
-  // taken at every set_matrix, so which factor a step uses never depends on timing.
+  // The factor refactored ahead, waiting for it (null if none was started or it failed).
+  // Offline (History::await_factor_ahead) one is taken at every set_matrix, so which factor a
+  // step uses never depends on timing.
   std::unique_ptr<FramedCholesky> take_prefactor() {
     if (!prefactor_.valid()) return nullptr;
+    prefactor_copied_ = {};
     return prefactor_.get();
   }
 
@@ -590,7 +632,10 @@ class CpuCgSolver final : public LinearSolver {
   SparseMatrix a_;
   Vector inv_diag_;
   std::unique_ptr<FramedCholesky> chol_;
-  std::future<std::unique_ptr<FramedCholesky>> prefactor_;  // the block's, refactored ahead
+  std::future<std::unique_ptr<FramedCholesky>> prefactor_;  // a block's, refactored ahead
+  std::future<void> prefactor_copied_;  // ready once that thread has its own copy of the block
+  // The rows changed since the block prefactor_ factors (none: it cannot take the present one).
+  std::optional<std::vector<int>> ahead_changed_;
   SparseMatrix decoupled_;  // D when some DOFs are held (else the block is a_ itself)
   // The block's rows that changed since chol_ factored it (none: unknown, compared instead).
   std::optional<std::vector<int>> changed_since_factor_;
@@ -613,6 +658,7 @@ class CpuCgSolver final : public LinearSolver {
   mutable std::optional<int> singular_dof_;  // where, once asked (singular_dof())
   double setup_ms_ = 0;
   int frame_updates_ = 0;
+  int taken_ahead_ = 0;
 };
 
 }  // namespace

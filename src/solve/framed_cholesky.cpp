@@ -234,12 +234,13 @@ struct FramedCholesky::Impl {
   }
 };
 
-FramedCholesky::FramedCholesky(const SparseMatrix& a, std::vector<int> frame)
-    : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(a.rows())) {
+FramedCholesky::FramedCholesky(SparseMatrix matrix, std::vector<int> frame)
+    : impl_(std::make_unique<Impl>()), rows_(static_cast<int>(matrix.rows())) {
   blas_info();  // before CHOLMOD's first call (solve/blas_guard.hpp)
   Impl& m = *impl_;
   const int n = rows_;
-  m.factored = a;
+  m.factored = std::move(matrix);
+  const SparseMatrix& a = m.factored;
   m.in_frame.assign(static_cast<size_t>(n), 0);
   std::sort(frame.begin(), frame.end());
   frame.erase(std::unique(frame.begin(), frame.end()), frame.end());
@@ -467,6 +468,8 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
   for (int j = 0; j < nb; ++j) x.row(frame_[static_cast<size_t>(j)]) = x_b.row(j);
   return x;
 }
+
+int FramedCholesky::extra_rows() const { return static_cast<int>(impl_->extra.rows.size()); }
 
 Vector FramedCholesky::solve(const Vector& b) const { return solve(Eigen::MatrixXd(b)).col(0); }
 

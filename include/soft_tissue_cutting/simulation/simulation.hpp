@@ -45,6 +45,11 @@ struct SimulationOptions {
   // not cut the whole backlog at once (docs/DESIGN.md section 10a, "Swap"). Offline
   // (wait_for_region_moves) every waiting sweep is cut at once.
   double waiting_cut_budget_ms = 8.0;
+  // Organ-scale meshes refactor a grown frame ahead on a second thread (docs/DESIGN.md section
+  // 6.2, "Refactored ahead"). On, the next cut awaits that factor (offline: deterministic, every
+  // run solves with the same factors); off (online), a cut takes it once it is ready and the
+  // loop never waits for it (the solutions differ by rounding only).
+  bool wait_for_factor_ahead = false;
 };
 
 // Stage timings and outcome of one step.

@@ -39,8 +39,9 @@ class FramedCholesky final : public CholeskySolve {
   static constexpr int kMaxExtraRows = 48;
 
   // Factors `a` (SPD, both triangles stored) with the DOFs in `frame` eliminated last and the
-  // others in AMD order. Throws std::runtime_error if `a` is not positive definite.
-  FramedCholesky(const SparseMatrix& a, std::vector<int> frame);
+  // others in AMD order (the factor keeps the matrix: a moved one is not copied again). Throws
+  // std::runtime_error if it is not positive definite.
+  FramedCholesky(SparseMatrix a, std::vector<int> frame);
   ~FramedCholesky() override;
   FramedCholesky(const FramedCholesky&) = delete;
   FramedCholesky& operator=(const FramedCholesky&) = delete;
@@ -61,6 +62,9 @@ class FramedCholesky final : public CholeskySolve {
   int rows() const override { return rows_; }
   int frame_size() const { return static_cast<int>(frame_.size()); }
   int updates() const { return updates_; }
+  // Rows of the sparse part that later changes moved into the frame (eq. (28); at most
+  // kMaxExtraRows).
+  int extra_rows() const;
   // Floating-point operations of the sparse factorization this object made (CHOLMOD's count
   // from the analysis): what refactoring a matrix like it costs.
   double factor_flops() const { return factor_flops_; }

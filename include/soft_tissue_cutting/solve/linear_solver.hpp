@@ -20,6 +20,11 @@ struct CgSettings {
   double tolerance = 1e-10;  // relative residual ||b - A x|| / ||b|| (docs/SCENE.md "Scene file",
                              // `solver.tolerance`)
   int max_iterations = 2000;
+  // A factor refactored ahead on a second thread (cpu_cg_solver.cpp, docs/DESIGN.md section 6.2)
+  // is awaited at the next matrix change (true: which factor solves a step never depends on
+  // timing; offline) or taken at the first change after it is ready (false: online, the loop
+  // never waits for that thread; a solution then differs by rounding only).
+  bool await_factor_ahead = true;
 };
 
 struct CgResult {
@@ -57,6 +62,8 @@ class LinearSolver {
   // How many set_matrix calls so far refactored only the frame around the last cut
   // (framed_cholesky.hpp); 0 for a solver that does not.
   virtual int frame_updates() const { return 0; }
+  // How many of those took a factor refactored ahead on a second thread (cpu_cg_solver.cpp).
+  virtual int factors_taken_ahead() const { return 0; }
   // Wall time of the last set_matrix in ms (factorization, for the Cholesky preconditioner).
   virtual double setup_ms() const { return 0; }
   // A changed (new matrix after a cut, or rescaled stiffness). Symmetric, upper+lower stored.
@@ -84,6 +91,7 @@ class LinearSolver {
     int interface_rows = 0;
     const std::vector<int>* changed_rows = nullptr;
     const std::vector<int>* expected_rows = nullptr;
+    bool await_factor_ahead = true;  // CgSettings::await_factor_ahead
   };
   virtual void set_matrix(const SparseMatrix& a, const std::vector<std::uint8_t>& held,
                           const History& history) {

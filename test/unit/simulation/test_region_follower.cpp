@@ -77,6 +77,7 @@ TEST(FollowRegion, FollowSceneRunsAndReportsMoves) {
   scene.operation_region.sphere.radius = 0.02;
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   Simulation sim(scene, offline);
   ASSERT_NE(sim.region_moves(), nullptr);
   // Press on the outer wall away from the initial ball: the region comes to the blade.
@@ -227,6 +228,7 @@ TEST(FollowRegion, BarCutInTwoHoldsTheEndThatOnlyTheInterfaceTouched) {
       "solver: {tolerance: 1.0e-12}\n"));
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   Simulation sim(scene, offline);
   // Edge along +y across the bar's height, blade normal along x: the blade plane x = 0.0525
   // (between node planes) sweeps along z through the whole width.
@@ -390,6 +392,7 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   test::append_line(poses, Vec3(x_in, 0.003, 0.12), Vec3(0.07, 0.003, 0.12), 20, q);   // lift
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   Simulation follow(scene, offline);
   const StrokeResult r = play_stroke(follow, poses, Vec3::UnitZ(), 0.03, 0.11);
   report("thigh 10 cm stroke, follow", follow, r);
@@ -495,6 +498,7 @@ TEST(FollowRegion, BladeHeldStillMidStrokeCostsNoMoves) {
   for (const BladePose& p : poses) held.insert(held.end(), 3, p);
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   Simulation once(scene, offline), thrice(scene, offline);
   const StrokeResult a = play_stroke(once, poses, Vec3::UnitZ(), 0.03, 0.11);
   report("thigh 10 cm stroke, one step per pose", once, a);
@@ -581,6 +585,7 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
   test::append_line(poses, last, last + Vec3(0, 0.03, 0), 20, q);  // lift out along the edge
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   Simulation follow(scene, offline);
   const StrokeResult f = play_stroke(follow, poses, Vec3::UnitX(), x0 + 0.01, last.x() - 0.01);
   std::printf("liver stroke %.1f cm\n", stroke * 100);
@@ -644,6 +649,7 @@ TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   }
   SimulationOptions offline;
   offline.wait_for_region_moves = true;
+  offline.wait_for_factor_ahead = true;
   int logged_pieces = 0, found_at_moves = 0;
   offline.log = [&](LogLevel, const std::string& m) {
     logged_pieces += test::pieces_reported(m);

@@ -42,6 +42,7 @@ template <typename Hold>
 Played play(const Scene& scene, Hold hold, const char* what) {
   SimulationOptions options;
   options.wait_for_region_moves = true;  // offline: a `follow` move is awaited (deterministic)
+  options.wait_for_factor_ahead = true;  // and a factor refactored ahead
   Simulation sim(scene, options);
   Played out;
   for (size_t k = 0; k < scene.trajectory.size(); ++k) {

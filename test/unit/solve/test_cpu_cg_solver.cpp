@@ -1,9 +1,13 @@
-// The CPU projected Jacobi-CG of solve/linear_solver.hpp against the direct CHOLMOD solve.
+// The CPU projected Jacobi-CG of solve/linear_solver.hpp against the direct CHOLMOD solve, and
+// its factor refactored ahead on a second thread.
 #include "soft_tissue_cutting/assembly/full_model.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/solve/sparse_cholesky.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
 
 namespace stc {
 namespace {
@@ -71,6 +75,98 @@ TEST(FemCgSolver, NeverReturnsAnIterateWorseThanItsStart) {
   EXPECT_EQ(x, Vector::Zero(2)) << "the worse iterate " << x.transpose() << " was returned";
   EXPECT_DOUBLE_EQ(r.residual, 1.0);  // the start's, not the last iterate's 2
   EXPECT_NE(r.message.find("the one before this pass is kept"), std::string::npos) << r.message;
+}
+
+// A matrix shaped like the organ liver's hybrid matrix, whose refactorization is dear enough
+// to be refactored ahead on a second thread (cpu_cg_solver.cpp, kPrefactorShare): a dense
+// leading block of `dense` rows (the interface, K0) coupled to one face of a g^3 grid (the
+// operation part, one DOF per node). Diagonally dominant, so SPD.
+SparseMatrix interface_heavy_matrix(int dense, int g) {
+  const int n = dense + g * g * g;
+  const auto node = [&](int x, int y, int z) { return dense + x + g * (y + g * z); };
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < dense; ++i) {
+    t.emplace_back(i, i, 3.0);
+    for (int j = 0; j < dense; ++j)
+      if (j != i) t.emplace_back(i, j, 0.1 / dense);
+    const int face = node(i % g, (i / g) % g, 0);
+    t.emplace_back(i, face, -0.2);
+    t.emplace_back(face, i, -0.2);
+  }
+  for (int z = 0; z < g; ++z)
+    for (int y = 0; y < g; ++y)
+      for (int x = 0; x < g; ++x) {
+        const int r = node(x, y, z);
+        t.emplace_back(r, r, 8.0);
+        if (x + 1 < g) t.emplace_back(r, node(x + 1, y, z), -1.0);
+        if (x > 0) t.emplace_back(r, node(x - 1, y, z), -1.0);
+        if (y + 1 < g) t.emplace_back(r, node(x, y + 1, z), -1.0);
+        if (y > 0) t.emplace_back(r, node(x, y - 1, z), -1.0);
+        if (z + 1 < g) t.emplace_back(r, node(x, y, z + 1), -1.0);
+        if (z > 0) t.emplace_back(r, node(x, y, z - 1), -1.0);
+      }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  return a;
+}
+
+// A cut walking through the grid: each change halves the couplings of one node with its
+// neighbours (the rows it names). Returns each step's solution; checks every solve is the
+// direct step (one iteration: the factor is exactly the matrix's) to 1e-10 against the matrix.
+std::vector<Vector> solves_along_a_walk(bool await_factor_ahead, int* taken_ahead) {
+  constexpr int kDense = 700, kGrid = 12;
+  SparseMatrix a = interface_heavy_matrix(kDense, kGrid);
+  const int n = static_cast<int>(a.rows());
+  auto solver = make_cpu_solver();
+  solver->set_matrix(a);
+  Vector b(n);
+  for (int i = 0; i < n; ++i) b[i] = std::sin(1.0 + i);
+  std::vector<Vector> out;
+  for (int step = 0; step < 30; ++step) {
+    const int x = 1 + step % 10, y = 3 + 3 * (step / 10), z = 6;
+    const int c = kDense + x + kGrid * (y + kGrid * z);
+    std::vector<int> changed = {c};
+    for (SparseMatrix::InnerIterator it(a, c); it; ++it)
+      if (it.index() != c && it.index() >= kDense) {
+        changed.push_back(static_cast<int>(it.index()));
+        a.coeffRef(c, it.index()) *= 0.5;
+        a.coeffRef(it.index(), c) *= 0.5;
+      }
+    LinearSolver::History history;
+    history.kept_rows = n;
+    history.interface_rows = kDense;
+    history.changed_rows = &changed;
+    history.await_factor_ahead = await_factor_ahead;
+    solver->set_matrix(a, {}, history);
+    Vector u = Vector::Zero(n);
+    const CgResult r = solver->solve(b, u, {}, CgSettings{1e-10, 100});
+    EXPECT_TRUE(r.converged) << "step " << step;
+    EXPECT_EQ(r.iterations, 1) << "step " << step << ": not the direct step";
+    EXPECT_LE((b - a * u).norm() / b.norm(), 1e-10) << "step " << step;
+    out.push_back(u);
+  }
+  *taken_ahead = solver->factors_taken_ahead();
+  return out;
+}
+
+// The factor refactored ahead (docs/DESIGN.md section 6.2): offline (await) it is taken at the
+// next change, so two runs solve with the same factors bit for bit; online it is taken once
+// ready, with every change made meanwhile, and the solutions differ by rounding only. The
+// thread factors its own copy of the matrix, which the solver changes meanwhile: a factor of
+// the changed arrays would not solve in one step.
+TEST(FemCgSolver, TakesTheFactorRefactoredAheadAwaitedOrWhenReady) {
+  int ahead_offline = 0, ahead_again = 0, ahead_online = 0;
+  const std::vector<Vector> offline = solves_along_a_walk(true, &ahead_offline);
+  const std::vector<Vector> again = solves_along_a_walk(true, &ahead_again);
+  const std::vector<Vector> online = solves_along_a_walk(false, &ahead_online);
+  EXPECT_GE(ahead_offline, 2) << "the walk should fill frames and refactor them ahead";
+  EXPECT_EQ(ahead_again, ahead_offline);
+  EXPECT_GE(ahead_online, 1);
+  for (size_t k = 0; k < offline.size(); ++k) {
+    EXPECT_TRUE(offline[k] == again[k]) << "step " << k << ": offline runs differ";
+    EXPECT_LE((online[k] - offline[k]).norm(), 1e-9 * offline[k].norm()) << "step " << k;
+  }
 }
 
 }  // namespace
