@@ -19,6 +19,11 @@ CutState make_cut_state(TetMesh& mesh, std::vector<std::uint8_t> locked,
   state.origin_volume.resize(mesh.tets.size());
   for (int t = 0; t < mesh.num_tets(); ++t) {
     state.origin_volume[t] = tet_volume(mesh, t);
+    const Tet& k = mesh.tets[t];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        state.longest_edge_bound =
+            std::max(state.longest_edge_bound, (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
     for (int v : mesh.tets[t]) {
       state.node_tets[v].push_back(t);
       if (!state.cuttable[t]) state.locked[v] = 1;

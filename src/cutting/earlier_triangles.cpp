@@ -125,11 +125,14 @@ void mark_faces_on_earlier_triangles(TetMesh& mesh, const CutState& state,
   off.erase(std::unique(off.begin(), off.end()), off.end());
   // side() puts a node off the stroke on the plane within 1e-9 x its longest edge: a node
   // farther off than 1e-9 x the longest of them all is not (the margin covers the two normals'
-  // round-off), and side() decides the rest.
-  double longest = 0;
+  // round-off), and side() decides the rest. The mesh's bound on every edge stands for that
+  // longest (a larger limit only asks side() more often): walking each node's star for it
+  // cost ~0.35 ms a cut on the organ liver.
+  double longest = state.longest_edge_bound;
   std::array<std::vector<double>, 3> position;
   for (int v : off) {
-    longest = std::max(longest, scales.longest_edge(mesh, state, v));
+    if (!(state.longest_edge_bound > 0))
+      longest = std::max(longest, scales.longest_edge(mesh, state, v));
     for (int k = 0; k < 3; ++k) position[k].push_back(mesh.nodes[v][k]);
   }
   const double never_on = 1e-9 * longest * (1 + 1e-6);

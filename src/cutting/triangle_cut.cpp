@@ -121,6 +121,13 @@ double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
   return *std::min_element(angles.begin(), angles.end());
 }
 
+double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
+  double longest = 0;
+  for (int t : state.node_tets[v])
+    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
+  return longest;
+}
+
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no
 // marked face touches, and its star keeps positive volume above the size guard and a smallest
 // dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
@@ -156,6 +163,7 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
   // cpu backends map the blade into rest coordinates ~1e-12 apart).
   if (after < std::min(before, options.relocate_min_dihedral_deg) - kAngleRoundOffDeg) return false;
   mesh.nodes[v] = target;
+  state.longest_edge_bound = std::max(state.longest_edge_bound, star_longest_edge(mesh, state, v));
   for (int t : star) {
     state.grid.insert(mesh, t);  // its box may have grown
     result.changed_tets.push_back(t);
@@ -165,13 +173,6 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
 }
 
 // The longest edge from v in its star.
-double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
-  double longest = 0;
-  for (int t : state.node_tets[v])
-    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
-  return longest;
-}
-
 }  // namespace
 
 StrokeSurface::StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles)

@@ -350,8 +350,14 @@ class CpuCgSolver final : public LinearSolver {
           held_.solve(*chol_, b, held, direct);
         } else {
           // D's held rows decouple: their values move to the right-hand side of the kept
-          // rows, and their own rows give them back (reset exactly below).
-          Vector rhs = b - a_ * x.cwiseProduct(held_mask_);
+          // rows, and their own rows give them back (reset exactly below). A is symmetric, so
+          // A (x .* held) is read from the held rows alone (a product with all of A cost
+          // ~0.5 ms a cut on the organ liver for a few held pieces).
+          Vector rhs = b;
+          for (Eigen::Index c = 0; c < n; ++c)
+            if (held_mask_[c] != 0 && x[c] != 0)
+              for (SparseMatrix::InnerIterator it(a_, c); it; ++it)
+                rhs[it.index()] -= it.value() * x[c];
           std::vector<int> held_k;  // the constrained kept DOFs
           for (int c : held)
             if (held_mask_[c] == 0) held_k.push_back(c);

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 
 namespace stc {
 namespace {
@@ -235,7 +236,16 @@ RunStats run_property(const Specimen& s, unsigned seed, int sequences, int lengt
       stats.cutting_sweeps += r.cut_faces_added > 0;
       stats.interface_hits += r.reached_interface;
       stats.tets_split += r.tets_split;
-      const auto violated = check_cut_invariants(mesh, state.origin_volume, limits);
+      std::vector<std::string> violated = check_cut_invariants(mesh, state.origin_volume, limits);
+      // The cut state's bound on every edge (earlier_triangles.cpp relies on it).
+      for (int t = 0; t < mesh.num_tets() && violated.empty(); ++t)
+        for (int i = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j)
+            if (const double e = (mesh.nodes[mesh.tets[t][i]] - mesh.nodes[mesh.tets[t][j]]).norm();
+                e > state.longest_edge_bound)
+              violated.push_back("an edge of " + std::to_string(e) +
+                                 " m passes the cut state's bound " +
+                                 std::to_string(state.longest_edge_bound) + " m");
       if (!violated.empty()) {
         ++stats.failures;
         ADD_FAILURE() << s.name << " seed " << seed << " sequence " << q << " sweep " << k << " ("
