@@ -201,7 +201,7 @@ double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 }  // namespace
 
 double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEdge& from,
-                             const BladeEdge& to, double tolerance) {
+                             const BladeEdge& to, double tolerance, double below) {
   const std::array<std::array<Vec3, 3>, 2> now = {
       {{from.tip, from.heel, to.heel}, {from.tip, to.heel, to.tip}}};
   const double length = (from.heel - from.tip).norm(), reach = tolerance * length;
@@ -224,28 +224,44 @@ double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEd
   }
   // Interior sample points of each triangle (barycentric grid), weighted by its area.
   constexpr int kGrid = 6;
-  double covered = 0, total = 0;
-  for (const auto& t : now) {
-    const double area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
+  constexpr int kSamples = kGrid * (kGrid + 1) / 2;
+  std::array<double, 2> area{};
+  double total = 0;
+  for (size_t k = 0; k < now.size(); ++k) {
+    const auto& t = now[k];
+    area[k] = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
     // A triangle narrower than `reach` across the edge (a blade held still, or moved along its
     // own edge: a plunge) sweeps nothing, whatever its last digits: else such a move measured
     // 0 when its area came out exactly 0 and 1 (wholly within reach of the last sweep) when
     // rounding left 1e-17, and a 1e-16 change of the poses freed the blade or not.
-    if (area <= 0.5 * reach * length) continue;
-    int in = 0, n = 0;
+    if (area[k] <= 0.5 * reach * length) area[k] = 0;
+    total += area[k];
+  }
+  // Uncovered area past which the fraction is surely under `below`.
+  const double too_much = (1 - below) * total * (1 + 1e-9) + 1e-300;
+  double uncovered = 0;
+  std::array<int, 2> in{};
+  for (size_t k = 0; k < now.size(); ++k) {
+    if (area[k] == 0) continue;
+    const auto& t = now[k];
     for (int i = 0; i < kGrid; ++i)
-      for (int j = 0; i + j < kGrid; ++j, ++n) {
+      for (int j = 0; i + j < kGrid; ++j) {
         const double u = (i + 1.0 / 3) / kGrid, v = (j + 1.0 / 3) / kGrid;
         const Vec3 p = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+        bool hit = false;
         for (const auto& b : before)
           if (distance_to_triangle(p, b[0], b[1], b[2]) <= reach) {
-            ++in;
+            hit = true;
             break;
           }
+        in[k] += hit;
+        if (!hit && below > 0 && (uncovered += area[k] / kSamples) > too_much)
+          return (total - uncovered) / total;
       }
-    covered += area * in / n;
-    total += area;
   }
+  double covered = 0;
+  for (size_t k = 0; k < now.size(); ++k)
+    if (area[k] > 0) covered += area[k] * in[k] / kSamples;
   return total > 0 ? covered / total : 0;
 }
 

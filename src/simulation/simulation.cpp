@@ -797,8 +797,8 @@ struct Simulation::Impl {
     const double length = scene.scalpel.blade_length;
     std::vector<BladeEdge> swept;
     for (const BladePose& p : stroke) swept.push_back(blade_edge(p, length));
-    const bool retracing =
-        last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length), edge) >= 0.9;
+    const bool retracing = last_pose && swept_before_fraction(swept, blade_edge(*last_pose, length),
+                                                              edge, 1e-4, 0.9) >= 0.9;
     if (last_pose && !retracing) {
       if (!follower)
         cut(*last_pose, blade, s);

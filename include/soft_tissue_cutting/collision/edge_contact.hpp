@@ -114,7 +114,10 @@ double sweep_area(const BladeEdge& from, const BladeEdge& to);
 // the edge, which sweeps nothing: a blade held still or moved along its own edge): 1 when the
 // blade moves back through the incision it has just cut. Points count as covered within
 // `tolerance` x the blade length of an earlier sweep triangle.
+// below > 0: the caller only asks whether the fraction reaches `below`; once enough of the sweep
+// is found uncovered that it cannot (by a margin far above rounding), some value under `below`
+// is returned without measuring the rest (a blade cutting forward: most steps).
 double swept_before_fraction(const std::vector<BladeEdge>& stroke, const BladeEdge& from,
-                             const BladeEdge& to, double tolerance = 1e-4);
+                             const BladeEdge& to, double tolerance = 1e-4, double below = 0);
 
 }  // namespace stc

@@ -11,6 +11,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
 
 namespace stc {
 namespace {
@@ -204,6 +207,50 @@ TEST(SegmentCrossing, ACollapsedTriangleIsNeverCrossed) {
       segment_crosses_triangle(Vec3(0.0131, 0.0119, 0.037), Vec3(0.013, 0.012, 0.06), a, p, p, s));
   EXPECT_FALSE(
       segment_crosses_triangle(Vec3(0.0131, 0.0119, 0.037), Vec3(0.013, 0.012, 0.06), p, p, p, s));
+}
+
+// The early answer of swept_before_fraction (below: only whether the fraction reaches it) is
+// the measured fraction's answer on every step of random strokes that go forward, turn back
+// through their own sweeps and stop; where the fraction reaches it, the value is the measured
+// one exactly.
+TEST(SweptBefore, TheEarlyAnswerIsTheMeasuredOnes) {
+  std::mt19937 rng(20261129);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  int retracing = 0, forward = 0;
+  for (int stroke_index = 0; stroke_index < 40; ++stroke_index) {
+    std::vector<BladeEdge> stroke;
+    BladeEdge edge{Vec3(0, 0, 0), Vec3(0, 0.03, 0)};
+    for (int k = 0; k < 60; ++k) {
+      BladeEdge next;
+      if (k % 20 < 12) {  // forward, wandering
+        const Vec3 step =
+            Vec3(1e-3, 0, 0) + 2e-4 * Vec3(uniform(rng), 0.2 * uniform(rng), uniform(rng));
+        next = {edge.tip + step, edge.heel + step};
+      } else if (k % 20 < 19) {  // back through its own incision, or a hair off it
+        const BladeEdge& back =
+            stroke[stroke.size() - 1 - static_cast<size_t>(2 * (k % 20 - 11) - 1)];
+        const Vec3 hair =
+            (k % 3 == 0 ? 3e-6 : 0.0) * Vec3(uniform(rng), uniform(rng), uniform(rng));
+        next = {back.tip + hair, back.heel + hair};
+      } else {
+        next = edge;  // held still
+      }
+      if (!stroke.empty()) {
+        const double measured = swept_before_fraction(stroke, edge, next);
+        const double early = swept_before_fraction(stroke, edge, next, 1e-4, 0.9);
+        ASSERT_EQ(measured >= 0.9, early >= 0.9) << "stroke " << stroke_index << " step " << k;
+        if (measured >= 0.9) {
+          EXPECT_EQ(early, measured);
+        }
+        (measured >= 0.9 ? retracing : forward) += 1;
+      }
+      stroke.push_back(edge);
+      edge = next;
+    }
+  }
+  EXPECT_GT(retracing, 100);  // both answers were asked for
+  EXPECT_GT(forward, 1000);
+  std::printf("swept before: %d steps retracing, %d not\n", retracing, forward);
 }
 
 }  // namespace
