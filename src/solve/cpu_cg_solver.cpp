@@ -535,7 +535,11 @@ class CpuCgSolver final : public LinearSolver {
       if (chol_->update(block, changed_since_factor_ ? &*changed_since_factor_ : nullptr,
                         update_limit(block.rows(), chol_->factor_flops()))) {
         ++frame_updates_;
-        if (changed && !prefactor_.valid() && chol_->frame_size() > kPrefactorShare * cap &&
+        // Refactored ahead when the frame or its extra rows fill up (a fresh factor with a
+        // small frame, a moved region's, meets the extra-row limit long before the cap).
+        const bool filling = chol_->frame_size() > kPrefactorShare * cap ||
+                             chol_->extra_rows() > kPrefactorShare * FramedCholesky::kMaxExtraRows;
+        if (changed && !prefactor_.valid() && filling &&
             refactor_is_dear(block.rows(), chol_->factor_flops()))
           prefactor(frame_for(block, previous, changed, dense, cap));
         return;

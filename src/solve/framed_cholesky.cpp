@@ -469,6 +469,8 @@ Eigen::MatrixXd FramedCholesky::solve(const Eigen::MatrixXd& b) const {
   return x;
 }
 
+int FramedCholesky::extra_rows() const { return static_cast<int>(impl_->extra.rows.size()); }
+
 Vector FramedCholesky::solve(const Vector& b) const { return solve(Eigen::MatrixXd(b)).col(0); }
 
 std::vector<int> FramedCholesky::frame_around_changes(const SparseMatrix& previous,

@@ -62,6 +62,9 @@ class FramedCholesky final : public CholeskySolve {
   int rows() const override { return rows_; }
   int frame_size() const { return static_cast<int>(frame_.size()); }
   int updates() const { return updates_; }
+  // Rows of the sparse part that later changes moved into the frame (eq. (28); at most
+  // kMaxExtraRows).
+  int extra_rows() const;
   // Floating-point operations of the sparse factorization this object made (CHOLMOD's count
   // from the analysis): what refactoring a matrix like it costs.
   double factor_flops() const { return factor_flops_; }
