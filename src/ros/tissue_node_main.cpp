@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
       else
         ROS_INFO("%s", message.c_str());
     };
+    // ~every_pose promises the same cut on every replay: a factor refactored ahead (organ-scale
+    // meshes) is then awaited as offline, so no solve depends on timing.
+    options.wait_for_factor_ahead = params.every_pose;
     scene = stc::ros_io::load_scene_param(params.scene);
     sim = std::make_unique<stc::Simulation>(scene, options);
   } catch (const std::exception& e) {
