@@ -121,6 +121,7 @@ double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
   return *std::min_element(angles.begin(), angles.end());
 }
 
+// The longest edge from v in its star.
 double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
   double longest = 0;
   for (int t : state.node_tets[v])
@@ -172,7 +173,6 @@ bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
   return true;
 }
 
-// The longest edge from v in its star.
 }  // namespace
 
 StrokeSurface::StrokeSurface(const std::vector<std::array<Vec3, 3>>& triangles)
