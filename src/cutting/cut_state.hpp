@@ -52,6 +52,9 @@ struct CutState {
   // next band carries the cut on from; finish_stroke conforms the cut to it (cut_sweep.hpp).
   std::vector<std::array<Vec3, 3>> last_band;
   std::vector<std::array<Vec3, 2>> last_front;  // segments, each on triangle 2k + 1
+  // The tets the current stroke changed (may repeat): smoothed when the next one begins
+  // (cut_smoothing.hpp).
+  std::vector<int> stroke_tets;
   // At least the length of every edge (rest): the input's longest, raised when a node moves
   // (relocate_node); a split or a copy makes no longer edge. 0: unknown.
   double longest_edge_bound = 0;

@@ -1,5 +1,6 @@
 #include "cutting/cut_sweep.hpp"
 
+#include "cutting/cut_smoothing.hpp"
 #include "cutting/earlier_triangles.hpp"
 #include "cutting/separation.hpp"
 #include "cutting/triangle_cut.hpp"
@@ -59,8 +60,15 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<CutBorder>& borders, double skin_slack,
                         const std::vector<std::array<Vec3, 3>>* corner_surface) {
   CutResult result;
-  // A new stroke: no node is on its cut surface yet.
-  if (also_mark_in.empty()) state.on_stroke.clear();
+  if (also_mark_in.empty()) {
+    // A new stroke: the last one's cut is complete, so its tets' shapes come first (not when it
+    // ends: a stroke ends on the step after the blade left, which may hold the blade still, and
+    // a held pose changes nothing - docs/DESIGN.md section 8, "Smooth"). No node is on the new
+    // stroke's surface yet.
+    smooth_last_stroke(mesh, state, options, result);
+    result.nodes_smoothed = static_cast<int>(result.moved_nodes.size());
+    state.on_stroke.clear();
+  }
   std::set<FaceKey> new_faces;
   const long marked_before = count_marked_face_sides(mesh);
   std::vector<TriangleClassification> cut;
@@ -105,6 +113,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   std::sort(result.changed_tets.begin(), result.changed_tets.end());
   result.changed_tets.erase(std::unique(result.changed_tets.begin(), result.changed_tets.end()),
                             result.changed_tets.end());
+  state.stroke_tets.insert(state.stroke_tets.end(), result.changed_tets.begin(),
+                           result.changed_tets.end());
   result.nodes_added = static_cast<int>(result.new_nodes.size());
   // Net new cut faces: each face is marked on both of its sides (open or closed), and a cut
   // face halved by a later split counts as one more.

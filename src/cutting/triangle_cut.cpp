@@ -1,6 +1,7 @@
 #include "cutting/triangle_cut.hpp"
 
 #include "cutting/edge_bisection.hpp"
+#include "cutting/node_moves.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
@@ -47,9 +48,6 @@ constexpr double kOnBorderSlack = 1e-6;
 
 // The six edges of a tet as local vertex pairs.
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-
-// Angles (degrees) this close are equal for the relocation's quality guard.
-constexpr double kAngleRoundOffDeg = 1e-6;
 
 struct Split {
   int a, b;  // a < b
@@ -116,60 +114,18 @@ bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vect
            options.min_volume_fraction * state.origin_volume[t]);
 }
 
-double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const auto angles = dihedral_angles_deg(a, b, c, d);
-  return *std::min_element(angles.begin(), angles.end());
-}
-
-// The longest edge from v in its star.
-double star_longest_edge(const TetMesh& mesh, const CutState& state, int v) {
-  double longest = 0;
-  for (int t : state.node_tets[v])
-    for (int w : mesh.tets[t]) longest = std::max(longest, (mesh.nodes[w] - mesh.nodes[v]).norm());
-  return longest;
-}
-
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no
 // marked face touches, and its star keeps positive volume above the size guard and a smallest
 // dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
 bool relocate_node(TetMesh& mesh, CutState& state, int v, const Vec3& target,
                    const CutOptions& options, CutResult& result) {
-  if (state.locked[v]) return false;
-  const std::vector<int>& star = state.node_tets[v];
-  for (int t : star) {
-    if (!state.cuttable[t]) return false;
-    for (int f = 0; f < 4; ++f) {
-      if (mesh.tets[t][f] == v) continue;        // the face opposite v does not touch it
-      if (mesh.is_cut_face(t, f)) return false;  // on an earlier cut
-      if (neighbour_across(mesh, state, t, f).first < 0) return false;  // on the boundary
-    }
-  }
-  double before = 180, after = 180;
-  auto position = [&](int w, const Vec3& here) -> const Vec3& {
-    return w == v ? here : mesh.nodes[w];
-  };
-  for (int t : star) {
-    const Tet& k = mesh.tets[t];
-    before = std::min(before, smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]],
-                                                mesh.nodes[k[2]], mesh.nodes[k[3]]));
-    const Vec3 &a = position(k[0], target), &b = position(k[1], target),
-               &c = position(k[2], target), &d = position(k[3], target);
-    if (!(signed_volume(a, b, c, d) > 2 * options.min_volume_fraction * state.origin_volume[t]))
-      return false;
-    after = std::min(after, smallest_dihedral(a, b, c, d));
-  }
-  // "No worse" up to round-off: a move along an edge of the star often leaves its smallest
-  // angle the same in exact arithmetic (the angle at an edge whose faces the move slides
-  // within), and the decision must not rest on the last digits of the position (the gl and
-  // cpu backends map the blade into rest coordinates ~1e-12 apart).
+  if (!may_move_inside_star(mesh, state, v)) return false;
+  const double before = star_smallest_dihedral(mesh, state, v, mesh.nodes[v], -1e300);
+  const double after =
+      star_smallest_dihedral(mesh, state, v, target, 2 * options.min_volume_fraction);
+  // "No worse" up to round-off (kAngleRoundOffDeg); -1 (a tet under the guard) always fails.
   if (after < std::min(before, options.relocate_min_dihedral_deg) - kAngleRoundOffDeg) return false;
-  mesh.nodes[v] = target;
-  state.longest_edge_bound = std::max(state.longest_edge_bound, star_longest_edge(mesh, state, v));
-  for (int t : star) {
-    state.grid.insert(mesh, t);  // its box may have grown
-    result.changed_tets.push_back(t);
-  }
-  result.moved_nodes.push_back(v);
+  move_node(mesh, state, v, target, result);
   return true;
 }
 

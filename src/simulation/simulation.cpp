@@ -335,7 +335,7 @@ struct Simulation::Impl {
     return adopt_cut(r, s);
   }
 
-  // The model after a cut changed the mesh; returns whether it did.
+  // The model after a cut changed the mesh; returns whether the cut did (CutResult::cut_anything).
   bool adopt_cut(const CutResult& r, StepStats& s) {
     s.reached_interface |= r.reached_interface;
     if (r.changed_tets.empty() && r.new_nodes.empty()) return false;
@@ -366,6 +366,9 @@ struct Simulation::Impl {
     cut_since_solve = true;
     rebuild_surface_tree();
     s.assembly_ms += ms_since(t0);
+    // Only nodes moved (the last stroke's smoothing at a new stroke's first band, or a node
+    // taken onto a cut that opened nothing there): the mesh changed, but nothing was cut.
+    if (!r.cut_anything()) return false;
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
     s.cutting = true;

@@ -36,6 +36,10 @@ struct CutOptions {
   // node keeps the total volume exactly (its star still tiles the same cavity).
   double relocate = 0.3;
   double relocate_min_dihedral_deg = 10.0;
+  // After each cut the nodes of the tets it left with a smallest dihedral angle below this
+  // (degrees) are moved inside their stars to raise it, where they may move (interior,
+  // unlocked, on no cut; cutting/cut_smoothing.hpp). 0: off.
+  double smooth_below_deg = 10.0;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
   // docs/SCENE.md "Cut invariants": "small fraction" is this number. With snap 0.1 a tet can be cut
@@ -70,6 +74,13 @@ struct CutResult {
   int nodes_added = 0;             // edge nodes + duplicates
   int cut_faces_added = 0;         // net new cut faces (each face once; a halved one counts 1 more)
   bool reached_interface = false;  // cut faces dropped so a locked node stays whole
+  // Of moved_nodes, how many the last stroke's smoothing moved (a new stroke's first cut does
+  // it first; cutting/cut_smoothing.hpp): a change of shape, not a cut.
+  int nodes_smoothed = 0;
+  // Did the cut split, add or mark anything? (Moving nodes alone - the smoothing, or a node
+  // relocated onto a cut that opened nothing there - changes the mesh's shape, not its cut:
+  // the same stroke again relocates what the last one's smoothing moved off it.)
+  bool cut_anything() const { return tets_split > 0 || !new_nodes.empty() || cut_faces_added != 0; }
 };
 
 }  // namespace stc

@@ -288,29 +288,61 @@ TEST(CutProperty, LiverThousandSweeps) {
 // Quality after 100 cuts: what the element shapes degrade to. Bisection at t in [0.1, 0.9]
 // can make thin children; the thresholds below are what the measured values clear with
 // margin, and the volume guard bounds the size loss independently of shape.
-void report_quality_after_100_cuts(const Specimen& s, unsigned seed, double min_dihedral,
-                                   double min_ratio) {
+struct Quality {
+  MeshQuality q;
+  int thin = 0;  // tets with a smallest dihedral angle under 5 deg
+  int cuts = 0;
+  double worst_fraction = 1;  // smallest volume / size class
+};
+
+Quality quality_after_100_cuts(const Specimen& s, unsigned seed, double smooth_below_deg) {
   TetMesh mesh = s.mesh;
   CutState state = make_cut_state(mesh, s.locked, s.cuttable);
-  const MeshQuality before = mesh_quality(mesh);
   SweepGenerator gen(s, seed);
-  int cuts = 0;
+  CutOptions options;
+  options.smooth_below_deg = smooth_below_deg;
+  Quality out;
   for (int k = 0; k < 100; ++k) {
     const Sweep sweep = gen.next(mesh, state);
-    cuts += cut_sweep(mesh, state, sweep.from, sweep.to).cut_faces_added > 0;
+    out.cuts += cut_sweep(mesh, state, sweep.from, sweep.to, options).cut_faces_added > 0;
   }
-  const MeshQuality after = mesh_quality(mesh);
-  double worst_fraction = 1;
-  for (int t = 0; t < mesh.num_tets(); ++t)
-    worst_fraction = std::min(worst_fraction, tet_volume(mesh, t) / state.origin_volume[t]);
-  std::printf(
-      "%s after 100 sweeps (%d cut): %d tets; min dihedral %.2f deg (%.2f before), "
-      "max %.2f deg; min volume ratio %.4f (%.4f before); smallest tet %.4f of its size class\n",
-      s.name.c_str(), cuts, mesh.num_tets(), after.min_dihedral_deg, before.min_dihedral_deg,
-      after.max_dihedral_deg, after.min_volume_ratio, before.min_volume_ratio, worst_fraction);
-  EXPECT_GT(after.min_dihedral_deg, min_dihedral);
-  EXPECT_GT(after.min_volume_ratio, min_ratio);
-  EXPECT_GE(worst_fraction, CutOptions{}.min_volume_fraction * (1 - 1e-9));
+  out.q = mesh_quality(mesh);
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    out.worst_fraction = std::min(out.worst_fraction, tet_volume(mesh, t) / state.origin_volume[t]);
+    const Tet& e = mesh.tets[t];
+    const auto angles =
+        dihedral_angles_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]], mesh.nodes[e[3]]);
+    out.thin += *std::min_element(angles.begin(), angles.end()) < 5.0;
+  }
+  return out;
+}
+
+// Seeds 99 and 2, each without and with the smoothing of docs/DESIGN.md section 8 ("Smooth"):
+// the tets under 5 deg must be at least `fewer` fewer in all with it; the smallest angle and
+// volume ratio stay above the thresholds in every run.
+void report_quality_after_100_cuts(const Specimen& s, double min_dihedral, double min_ratio,
+                                   double fewer) {
+  const MeshQuality before = mesh_quality(s.mesh);
+  int thin[2] = {0, 0};
+  for (unsigned seed : {99u, 2u}) {
+    for (int smooth = 0; smooth < 2; ++smooth) {
+      const Quality a = quality_after_100_cuts(s, seed, smooth ? CutOptions{}.smooth_below_deg : 0);
+      thin[smooth] += a.thin;
+      std::printf(
+          "%s seed %u, %s: %d of 100 sweeps cut; min dihedral %.2f deg (%.2f before), %d tets "
+          "under 5 deg; max %.2f deg; min volume ratio %.4f (%.4f before); smallest tet %.4f of "
+          "its size class\n",
+          s.name.c_str(), seed, smooth ? "smoothed" : "not smoothed", a.cuts, a.q.min_dihedral_deg,
+          before.min_dihedral_deg, a.thin, a.q.max_dihedral_deg, a.q.min_volume_ratio,
+          before.min_volume_ratio, a.worst_fraction);
+      EXPECT_GT(a.q.min_dihedral_deg, min_dihedral) << s.name << " seed " << seed;
+      EXPECT_GT(a.q.min_volume_ratio, min_ratio) << s.name << " seed " << seed;
+      EXPECT_GE(a.worst_fraction, CutOptions{}.min_volume_fraction * (1 - 1e-9));
+    }
+  }
+  std::printf("%s: tets under 5 deg after 100 sweeps, 2 seeds: %d -> %d smoothed (%.0f %%)\n",
+              s.name.c_str(), thin[0], thin[1], 100.0 * (thin[1] - thin[0]) / thin[0]);
+  EXPECT_LE(thin[1], (1 - fewer) * thin[0]) << s.name;
 }
 
 TEST(CutProperty, QualityAfter100Cuts) {
@@ -323,9 +355,15 @@ TEST(CutProperty, QualityAfter100Cuts) {
   // With conformed borders (stop 27): thigh 0.61 deg / 0.0039, box 0.91 / 0.0031, liver
   // 0.52 / 0.0027, and 30-50 % more tets after the 100 sweeps (the tets a border runs through
   // are cut twice): the price of opening up to the blade.
-  report_quality_after_100_cuts(thigh_specimen(), 99u, 0.2, 0.0015);
-  report_quality_after_100_cuts(box_specimen(), 99u, 0.6, 0.0029);
-  report_quality_after_100_cuts(liver_specimen(), 99u, 0.35, 0.0012);
+  // Stop 36, seeds 99 / 1 / 2 / 3 / 4 without -> with smoothing: the minima scatter with the cut
+  // sequence (thigh 0.44-1.02 -> 0.69-1.17 deg, ratio 0.0018-0.0039 -> 0.0015-0.0049; box
+  // 0.91-1.42 -> 0.85-1.36 deg, 0.0026-0.0033 -> 0.0021-0.0031; liver 0.52-0.93 -> 0.41-0.88 deg,
+  // 0.0014-0.0029 -> 0.0012-0.0025), so the thresholds are below every run; the tets under
+  // 5 deg fall by a quarter on average (thigh 192 -> 144, box 184 -> 146, liver 132 -> 107),
+  // though not in every run (box seed 1: 118 -> 144).
+  report_quality_after_100_cuts(thigh_specimen(), 0.2, 0.0008, 0.2);
+  report_quality_after_100_cuts(box_specimen(), 0.5, 0.0012, 0.2);
+  report_quality_after_100_cuts(liver_specimen(), 0.2, 0.0008, 0.15);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_cut_fidelity.cpp
   test/unit/cutting/test_cut_fidelity_gravity.cpp
   test/unit/cutting/test_cut_property.cpp
+  test/unit/cutting/test_cut_smoothing.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
   test/unit/cutting/test_earlier_triangles.cpp
 )

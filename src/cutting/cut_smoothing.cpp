@@ -1,0 +1,172 @@
+#include "cutting/cut_smoothing.hpp"
+
+#include "cutting/node_moves.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace stc {
+namespace {
+
+// A search step must raise the star's smallest angle by more than this (degrees): well above
+// round-off, so a step is not decided by the last digits of a position.
+constexpr double kStepGainDeg = 1e-4;
+// A move is kept only if it raises the star's smallest angle by this much (degrees).
+constexpr double kMoveGainDeg = 0.05;
+
+// The smallest dihedral angle of tet t with node v at x.
+double tet_smallest_dihedral(const TetMesh& mesh, int t, int v, const Vec3& x) {
+  const Tet& k = mesh.tets[t];
+  const Vec3* p[4];
+  for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
+  return smallest_dihedral(*p[0], *p[1], *p[2], *p[3]);
+}
+
+// The volume of v's star with v at x.
+double star_volume(const TetMesh& mesh, const CutState& state, int v, const Vec3& x) {
+  double volume = 0;
+  for (int t : state.node_tets[v]) {
+    const Tet& k = mesh.tets[t];
+    const Vec3* p[4];
+    for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
+    volume += signed_volume(*p[0], *p[1], *p[2], *p[3]);
+  }
+  return volume;
+}
+
+// The smallest volume ratio of v's star with v at x: 6 sqrt(2) volume / (longest edge)^3, 1 for
+// a regular tet (mesh/quality.hpp's measure).
+double star_smallest_volume_ratio(const TetMesh& mesh, const CutState& state, int v,
+                                  const Vec3& x) {
+  double smallest = 1e300;
+  for (int t : state.node_tets[v]) {
+    const Tet& k = mesh.tets[t];
+    const Vec3* p[4];
+    double longest = 0;
+    for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (*p[i] - *p[j]).norm());
+    smallest = std::min(smallest, 6 * std::sqrt(2.0) * signed_volume(*p[0], *p[1], *p[2], *p[3]) /
+                                      (longest * longest * longest));
+  }
+  return smallest;
+}
+
+// Eq. (20b): maximise q(x) = the smallest dihedral angle of v's star over v's position x by an
+// ascent on the worst tet's smallest angle (its gradient by central differences) with a step
+// that grows on success and halves on failure; q is non-smooth where two tets tie, which the
+// step's acceptance test (q itself, not the worst tet's angle) handles. Returns the best x.
+// A boundary node's moves are projected onto its fan's plane (plane_normal; zero: free).
+Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double guard,
+                   const Vec3& plane_normal, double& quality) {
+  const auto in_plane = [&plane_normal](const Vec3& d) -> Vec3 {
+    return d - plane_normal * plane_normal.dot(d);
+  };
+  const Vec3 start = mesh.nodes[v];
+  double shortest = 1e300;
+  Vec3 centroid = Vec3::Zero();
+  int neighbours = 0;
+  for (int t : state.node_tets[v])
+    for (int w : mesh.tets[t])
+      if (w != v) {
+        shortest = std::min(shortest, (mesh.nodes[w] - start).norm());
+        centroid += mesh.nodes[w];
+        ++neighbours;
+      }
+  Vec3 x = start;
+  double q = star_smallest_dihedral(mesh, state, v, x, guard);
+  // No tet of the star may end up flatter by the other measure than the star's worst now.
+  const double ratio_floor = star_smallest_volume_ratio(mesh, state, v, start);
+  const auto better = [&](const Vec3& y, double qy) {
+    return qy > q + kStepGainDeg && star_smallest_volume_ratio(mesh, state, v, y) >= ratio_floor;
+  };
+  // The centroid of the star's other corners (Laplacian smoothing) as a first guess.
+  if (neighbours > 0) {
+    const Vec3 c = start + in_plane(centroid / neighbours - start);
+    const double qc = star_smallest_dihedral(mesh, state, v, c, guard);
+    if (better(c, qc)) x = c, q = qc;
+  }
+  double step = 0.1 * shortest;
+  const double eps = 1e-4 * shortest, smallest_step = 1e-3 * shortest;
+  for (int iteration = 0; iteration < 40 && step > smallest_step; ++iteration) {
+    int worst = -1;
+    double worst_angle = 1e300;
+    for (int t : state.node_tets[v]) {
+      const double a = tet_smallest_dihedral(mesh, t, v, x);
+      if (a < worst_angle) worst_angle = a, worst = t;
+    }
+    Vec3 gradient;
+    for (int i = 0; i < 3; ++i) {
+      Vec3 up = x, down = x;
+      up[i] += eps;
+      down[i] -= eps;
+      gradient[i] = (tet_smallest_dihedral(mesh, worst, v, up) -
+                     tet_smallest_dihedral(mesh, worst, v, down)) /
+                    (2 * eps);
+    }
+    // Within the plane; a gradient (nearly) normal to it is none: what is left of it after the
+    // projection is round-off, and normalising it would step off the plane.
+    const Vec3 along = in_plane(gradient);
+    if (!(along.norm() > 1e-6 * gradient.norm())) break;
+    const Vec3 y = x + in_plane(step * along.normalized());
+    const double qy = star_smallest_dihedral(mesh, state, v, y, guard);
+    if (better(y, qy)) {
+      x = y, q = qy;
+      step = std::min(1.5 * step, 0.5 * shortest);
+    } else {
+      step *= 0.5;
+    }
+  }
+  quality = q;
+  return x;
+}
+
+// Smooths the nodes of `tets` (those below the threshold) that may move.
+void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
+                 const std::vector<int>& tets, CutResult& result) {
+  if (!(options.smooth_below_deg > 0)) return;
+  const double guard = 2 * options.min_volume_fraction;
+  for (int pass = 0; pass < 2; ++pass) {
+    // The candidates in ascending order: the result does not depend on the tets' order.
+    std::set<int> nodes;
+    for (int t : (pass == 0 ? tets : result.changed_tets)) {
+      const Tet& k = mesh.tets[t];
+      if (smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
+                            mesh.nodes[k[3]]) >= options.smooth_below_deg)
+        continue;
+      for (int v : k) nodes.insert(v);
+    }
+    bool moved = false;
+    for (int v : nodes) {
+      Vec3 normal = Vec3::Zero();
+      if (!may_move_inside_star(mesh, state, v) && !may_slide_on_plane(mesh, state, v, normal))
+        continue;
+      const double before = star_smallest_dihedral(mesh, state, v, mesh.nodes[v], -1e300);
+      double after = before;
+      const Vec3 x = best_position(mesh, state, v, guard, normal, after);
+      if (!(after > before + kMoveGainDeg)) continue;
+      // The star's volume is affine in x_v with a gradient along the fan's normal (zero inside):
+      // a move that changes it beyond round-off is refused (docs/SCENE.md "Cut invariants" 2).
+      if (std::abs(star_volume(mesh, state, v, x) - star_volume(mesh, state, v, mesh.nodes[v])) >
+          1e-12 * star_volume(mesh, state, v, mesh.nodes[v]))
+        continue;
+      move_node(mesh, state, v, x, result);
+      moved = true;
+    }
+    if (!moved) break;
+  }
+}
+
+}  // namespace
+
+void smooth_last_stroke(TetMesh& mesh, CutState& state, const CutOptions& options,
+                        CutResult& result) {
+  std::vector<int> tets = std::move(state.stroke_tets);
+  state.stroke_tets.clear();
+  std::sort(tets.begin(), tets.end());
+  tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+  smooth_tets(mesh, state, options, tets, result);
+}
+
+}  // namespace stc

@@ -1,0 +1,46 @@
+// Moving a node's rest position inside its own star: onto a cut instead of splitting a sliver
+// off (triangle_cut.cpp, "relocate") and to raise the smallest dihedral angle around a cut
+// (cut_smoothing.hpp). docs/DESIGN.md section 8 says why the volume stays exact.
+#pragma once
+
+#include "cutting/cut_state.hpp"
+#include "soft_tissue_cutting/cutting/cut_result.hpp"
+
+namespace stc {
+
+// Angles (degrees) this close are equal for the quality guards of node moves: a move along an
+// edge of the star often leaves its smallest angle the same in exact arithmetic, and a decision
+// must not rest on the last digits of a position (the gl and cpu backends map the blade into
+// rest coordinates ~1e-12 apart).
+constexpr double kAngleRoundOffDeg = 1e-6;
+
+double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+// May node v move inside its star: unlocked, every tet of the star cuttable, and no face of the
+// star that touches v on the boundary or on a cut? Then the star's outer faces are interior and
+// fixed, so wherever v goes while every star tet stays positive, the star tiles the same cavity:
+// no surface moves and the volume is exact.
+bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v);
+
+// May node v slide within a plane: unlocked, every tet of its star cuttable, and the faces of
+// its star that touch v and lie on the boundary (an opened cut's walls, the tissue's surface)
+// form one fan, flat to round-off (every corner within 1e-9 of the star's scale of one plane,
+// all facing one way), while no face touching v is a cut face that has not opened? Then a move
+// within that plane keeps the surface where it is (the fan still tiles the same flat polygon)
+// and the volume exact; `normal` is the fan's unit normal. Interior nodes are not "sliding"
+// ones (may_move_inside_star).
+bool may_slide_on_plane(const TetMesh& mesh, const CutState& state, int v, Vec3& normal);
+
+// The smallest dihedral angle (degrees) of v's star with v at x, or -1 when a tet of it would
+// keep no more than `guard` x its size class (or turn over).
+double star_smallest_dihedral(const TetMesh& mesh, const CutState& state, int v, const Vec3& x,
+                              double guard);
+
+// The longest edge from v in its star.
+double star_longest_edge(const TetMesh& mesh, const CutState& state, int v);
+
+// Moves v to x and records it: its star's tets changed (grid boxes refreshed), v moved, the
+// state's edge bound raised.
+void move_node(TetMesh& mesh, CutState& state, int v, const Vec3& x, CutResult& result);
+
+}  // namespace stc
