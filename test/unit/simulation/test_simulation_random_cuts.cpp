@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -200,12 +201,18 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   const auto report = [&](int done) {
     std::vector<int> sorted = iterations;
     std::sort(sorted.begin(), sorted.end());
+    int thin = 0;
+    for (const Tet& e : sim.mesh().tets) {
+      const auto angles = dihedral_angles_deg(sim.mesh().nodes[e[0]], sim.mesh().nodes[e[1]],
+                                              sim.mesh().nodes[e[2]], sim.mesh().nodes[e[3]]);
+      thin += *std::min_element(angles.begin(), angles.end()) < 5.0;
+    }
     std::printf(
         "TetGen liver, %d random strokes: %d cut, %d tets, %d free pieces held; min dihedral "
-        "%.2f -> %.2f deg; CG iterations after a stroke: median %d, max %d (uncut cold solve %d); "
-        "%d solves short of 1e-10 (worst residual %.1e)\n",
+        "%.2f -> %.2f deg, %d tets under 5 deg; CG iterations after a stroke: median %d, max %d "
+        "(uncut cold solve %d); %d solves short of 1e-10 (worst residual %.1e)\n",
         done, cuts, sim.counts().tets, sim.counts().free_pieces_held, dihedral_before,
-        mesh_quality(sim.mesh()).min_dihedral_deg, sorted[sorted.size() / 2], sorted.back(),
+        mesh_quality(sim.mesh()).min_dihedral_deg, thin, sorted[sorted.size() / 2], sorted.back(),
         cold_iterations, not_converged, worst_residual);
     std::fflush(stdout);
   };
