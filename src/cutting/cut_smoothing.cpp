@@ -53,6 +53,17 @@ double star_smallest_volume_ratio(const TetMesh& mesh, const CutState& state, in
   return smallest;
 }
 
+// The tet of v's star with the smallest dihedral angle, v at x.
+int worst_tet(const TetMesh& mesh, const CutState& state, int v, const Vec3& x) {
+  int worst = -1;
+  double worst_angle = 1e300;
+  for (int t : state.node_tets[v]) {
+    const double a = tet_smallest_dihedral(mesh, t, v, x);
+    if (a < worst_angle) worst_angle = a, worst = t;
+  }
+  return worst;
+}
+
 // Eq. (20b): maximise q(x) = the smallest dihedral angle of v's star over v's position x by an
 // ascent on the worst tet's smallest angle (its gradient by central differences) with a step
 // that grows on success and halves on failure; q is non-smooth where two tets tie, which the
@@ -88,34 +99,35 @@ Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double gua
     if (better(c, qc)) x = c, q = qc;
   }
   double step = 0.1 * shortest;
-  const double eps = 1e-4 * shortest, smallest_step = 1e-3 * shortest;
-  for (int iteration = 0; iteration < 40 && step > smallest_step; ++iteration) {
-    int worst = -1;
-    double worst_angle = 1e300;
-    for (int t : state.node_tets[v]) {
-      const double a = tet_smallest_dihedral(mesh, t, v, x);
-      if (a < worst_angle) worst_angle = a, worst = t;
-    }
+  const double eps = 1e-4 * shortest, smallest_step = 1e-2 * shortest;
+  // The ascent direction at x: the worst tet's gradient within the plane (zero: none). A
+  // gradient (nearly) normal to the plane is none: what the projection leaves of it is
+  // round-off, and normalising that would step off the plane.
+  const auto direction = [&](const Vec3& at) -> Vec3 {
+    const int worst = worst_tet(mesh, state, v, at);
     Vec3 gradient;
     for (int i = 0; i < 3; ++i) {
-      Vec3 up = x, down = x;
+      Vec3 up = at, down = at;
       up[i] += eps;
       down[i] -= eps;
       gradient[i] = (tet_smallest_dihedral(mesh, worst, v, up) -
                      tet_smallest_dihedral(mesh, worst, v, down)) /
                     (2 * eps);
     }
-    // Within the plane; a gradient (nearly) normal to it is none: what is left of it after the
-    // projection is round-off, and normalising it would step off the plane.
     const Vec3 along = in_plane(gradient);
-    if (!(along.norm() > 1e-6 * gradient.norm())) break;
-    const Vec3 y = x + in_plane(step * along.normalized());
+    return along.norm() > 1e-6 * gradient.norm() ? Vec3(along.normalized()) : Vec3::Zero();
+  };
+  Vec3 along = direction(x);
+  for (int iteration = 0; iteration < 30 && step > smallest_step && along != Vec3::Zero();
+       ++iteration) {
+    const Vec3 y = x + in_plane(step * along);
     const double qy = star_smallest_dihedral(mesh, state, v, y, guard);
     if (better(y, qy)) {
       x = y, q = qy;
+      along = direction(x);
       step = std::min(1.5 * step, 0.5 * shortest);
     } else {
-      step *= 0.5;
+      step *= 0.5;  // the same direction, a shorter step
     }
   }
   quality = q;
