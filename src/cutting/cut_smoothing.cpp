@@ -160,9 +160,8 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
       if (!(after > before + kMoveGainDeg)) continue;
       // The star's volume is affine in x_v with a gradient along the fan's normal (zero inside):
       // a move that changes it beyond round-off is refused (docs/SCENE.md "Cut invariants" 2).
-      if (std::abs(star_volume(mesh, state, v, x) - star_volume(mesh, state, v, mesh.nodes[v])) >
-          1e-12 * star_volume(mesh, state, v, mesh.nodes[v]))
-        continue;
+      const double volume = star_volume(mesh, state, v, mesh.nodes[v]);
+      if (std::abs(star_volume(mesh, state, v, x) - volume) > 1e-12 * volume) continue;
       move_node(mesh, state, v, x, result);
       moved = true;
     }

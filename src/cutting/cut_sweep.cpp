@@ -115,6 +115,11 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
                             result.changed_tets.end());
   state.stroke_tets.insert(state.stroke_tets.end(), result.changed_tets.begin(),
                            result.changed_tets.end());
+  if (state.stroke_tets.size() > 2 * mesh.tets.size()) {  // a long stroke: no tet twice
+    std::sort(state.stroke_tets.begin(), state.stroke_tets.end());
+    state.stroke_tets.erase(std::unique(state.stroke_tets.begin(), state.stroke_tets.end()),
+                            state.stroke_tets.end());
+  }
   result.nodes_added = static_cast<int>(result.new_nodes.size());
   // Net new cut faces: each face is marked on both of its sides (open or closed), and a cut
   // face halved by a later split counts as one more.
