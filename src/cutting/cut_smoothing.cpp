@@ -1,6 +1,7 @@
 #include "cutting/cut_smoothing.hpp"
 
 #include "cutting/node_moves.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,7 @@ double tet_smallest_dihedral(const TetMesh& mesh, int t, int v, const Vec3& x) {
   const Tet& k = mesh.tets[t];
   const Vec3* p[4];
   for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
-  return smallest_dihedral(*p[0], *p[1], *p[2], *p[3]);
+  return smallest_dihedral_deg(*p[0], *p[1], *p[2], *p[3]);
 }
 
 // The volume of v's star with v at x.
@@ -144,8 +145,8 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
     std::set<int> nodes;
     for (int t : (pass == 0 ? tets : result.changed_tets)) {
       const Tet& k = mesh.tets[t];
-      if (smallest_dihedral(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
-                            mesh.nodes[k[3]]) >= options.smooth_below_deg)
+      if (smallest_dihedral_deg(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
+                                mesh.nodes[k[3]]) >= options.smooth_below_deg)
         continue;
       for (int v : k) nodes.insert(v);
     }

@@ -1,29 +1,12 @@
 #include "cutting/node_moves.hpp"
 
 #include "cutting/triangle_cut.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace stc {
-
-double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  // The angle at the edge of faces f and g is 180 deg - acos(n_f . n_g) (outward unit normals,
-  // mesh/quality.cpp), increasing as the dot product falls: the smallest is that of the least
-  // dot product, one acos instead of six (the same value: every step is monotonic).
-  const Vec3 p[4] = {a, b, c, d};
-  Vec3 n[4];
-  for (int f = 0; f < 4; ++f) {
-    const auto& lf = kTetFaces[f];
-    n[f] = (p[lf[1]] - p[lf[0]]).cross(p[lf[2]] - p[lf[0]]);
-    const double len = n[f].norm();
-    if (len > 0) n[f] /= len;
-  }
-  double least = 1e300;
-  for (int f = 0; f < 4; ++f)
-    for (int g = f + 1; g < 4; ++g) least = std::min(least, n[f].dot(n[g]));
-  return 180.0 - std::acos(std::clamp(least, -1.0, 1.0)) * 180.0 / M_PI;
-}
 
 bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v) {
   if (state.locked[v]) return false;
@@ -94,7 +77,7 @@ double star_smallest_dihedral(const TetMesh& mesh, const CutState& state, int v,
     const Vec3* p[4];
     for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
     if (!(signed_volume(*p[0], *p[1], *p[2], *p[3]) > guard * state.origin_volume[t])) return -1;
-    smallest = std::min(smallest, smallest_dihedral(*p[0], *p[1], *p[2], *p[3]));
+    smallest = std::min(smallest, smallest_dihedral_deg(*p[0], *p[1], *p[2], *p[3]));
   }
   return smallest;
 }

@@ -14,8 +14,6 @@ namespace stc {
 // rest coordinates ~1e-12 apart).
 constexpr double kAngleRoundOffDeg = 1e-6;
 
-double smallest_dihedral(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
-
 // May node v move inside its star: unlocked, every tet of the star cuttable, and no face of the
 // star that touches v on the boundary or on a cut? Then the star's outer faces are interior and
 // fixed, so wherever v goes while every star tet stays positive, the star tiles the same cavity:

@@ -6,24 +6,47 @@
 
 namespace stc {
 
-std::array<double, 6> dihedral_angles_deg(const Vec3& a, const Vec3& b, const Vec3& c,
-                                          const Vec3& d) {
+namespace {
+
+// Outward unit face normals (face f opposite vertex f). The dihedral angle at the edge shared by
+// faces f and g is pi minus the angle between their outward normals.
+std::array<Vec3, 4> outward_unit_normals(const Vec3& a, const Vec3& b, const Vec3& c,
+                                         const Vec3& d) {
   const Vec3 p[4] = {a, b, c, d};
-  // Outward face normals (face f opposite vertex f); the dihedral angle at the edge shared
-  // by faces f and g is pi minus the angle between their outward normals.
-  Vec3 n[4];
+  std::array<Vec3, 4> n;
   for (int f = 0; f < 4; ++f) {
     const auto& lf = kTetFaces[f];
     n[f] = (p[lf[1]] - p[lf[0]]).cross(p[lf[2]] - p[lf[0]]);
     const double len = n[f].norm();
     if (len > 0) n[f] /= len;
   }
+  return n;
+}
+
+double angle_deg(double normals_dot) {
+  return 180.0 - std::acos(std::clamp(normals_dot, -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+std::array<double, 6> dihedral_angles_deg(const Vec3& a, const Vec3& b, const Vec3& c,
+                                          const Vec3& d) {
+  const std::array<Vec3, 4> n = outward_unit_normals(a, b, c, d);
   std::array<double, 6> angles{};
   int k = 0;
   for (int f = 0; f < 4; ++f)
-    for (int g = f + 1; g < 4; ++g)
-      angles[k++] = 180.0 - std::acos(std::clamp(n[f].dot(n[g]), -1.0, 1.0)) * 180.0 / M_PI;
+    for (int g = f + 1; g < 4; ++g) angles[k++] = angle_deg(n[f].dot(n[g]));
   return angles;
+}
+
+double smallest_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  // The angle grows as the normals' dot product falls, and every step of angle_deg is
+  // monotonic: the least dot product gives the smallest angle, bit for bit.
+  const std::array<Vec3, 4> n = outward_unit_normals(a, b, c, d);
+  double least = 1e300;
+  for (int f = 0; f < 4; ++f)
+    for (int g = f + 1; g < 4; ++g) least = std::min(least, n[f].dot(n[g]));
+  return angle_deg(least);
 }
 
 MeshQuality mesh_quality(const TetMesh& mesh) {

@@ -9,6 +9,10 @@ namespace stc {
 std::array<double, 6> dihedral_angles_deg(const Vec3& a, const Vec3& b, const Vec3& c,
                                           const Vec3& d);
 
+// The smallest of them: the same value as the least of dihedral_angles_deg, with one acos
+// instead of six (a node move's quality test evaluates it for every tet of a star, many times).
+double smallest_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
 struct MeshQuality {
   double min_dihedral_deg = 0;
   double max_dihedral_deg = 0;

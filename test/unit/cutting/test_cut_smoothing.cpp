@@ -179,8 +179,8 @@ TEST(CutSmoothing, TheNextStrokeSmoothsTheLastOnesTets) {
     EXPECT_NEAR(test::open_cut_area(mesh), open, 1e-12 * open);
     EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
     for (const Tet& e : mesh.tets)
-      thin_after += smallest_dihedral(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                      mesh.nodes[e[3]]) < 10.0;
+      thin_after += smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                                          mesh.nodes[e[3]]) < 10.0;
     std::printf(
         "box, 3 strokes, smoothing below %.0f deg: %d nodes moved, %d tets under 10 deg at "
         "the end, min dihedral %.2f deg\n",
