@@ -140,10 +140,13 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
                  const std::vector<int>& tets, CutResult& result) {
   if (!(options.smooth_below_deg > 0)) return;
   const double guard = 2 * options.min_volume_fraction;
+  std::vector<int> changed = tets;
   for (int pass = 0; pass < 2; ++pass) {
-    // The candidates in ascending order: the result does not depend on the tets' order.
+    // The candidates in ascending order: the result does not depend on the tets' order. The
+    // second pass looks at the tets the first one changed.
+    const size_t changed_before = result.changed_tets.size();
     std::set<int> nodes;
-    for (int t : (pass == 0 ? tets : result.changed_tets)) {
+    for (int t : changed) {
       const Tet& k = mesh.tets[t];
       if (smallest_dihedral_deg(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
                                 mesh.nodes[k[3]]) >= options.smooth_below_deg)
@@ -152,9 +155,8 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
     }
     bool moved = false;
     for (int v : nodes) {
-      Vec3 normal = Vec3::Zero();
-      if (!may_move_inside_star(mesh, state, v) && !may_slide_on_plane(mesh, state, v, normal))
-        continue;
+      Vec3 normal = Vec3::Zero();  // stays zero for a move inside the star
+      if (how_node_may_move(mesh, state, v, normal) == NodeMove::kNone) continue;
       const double before = star_smallest_dihedral(mesh, state, v, mesh.nodes[v], -1e300);
       double after = before;
       const Vec3 x = best_position(mesh, state, v, guard, normal, after);
@@ -167,6 +169,8 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
       moved = true;
     }
     if (!moved) break;
+    changed.assign(result.changed_tets.begin() + static_cast<std::ptrdiff_t>(changed_before),
+                   result.changed_tets.end());
   }
 }
 

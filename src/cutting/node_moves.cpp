@@ -8,33 +8,22 @@
 
 namespace stc {
 
-bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v) {
-  if (state.locked[v]) return false;
-  for (int t : state.node_tets[v]) {
-    if (!state.cuttable[t]) return false;
-    for (int f = 0; f < 4; ++f) {
-      if (mesh.tets[t][f] == v) continue;                               // opposite v
-      if (mesh.is_cut_face(t, f)) return false;                         // on a cut
-      if (neighbour_across(mesh, state, t, f).first < 0) return false;  // on the boundary
-    }
-  }
-  return true;
-}
-
-bool may_slide_on_plane(const TetMesh& mesh, const CutState& state, int v, Vec3& normal) {
-  if (state.locked[v]) return false;
+NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& normal) {
+  if (state.locked[v]) return NodeMove::kNone;
   // The fan: faces touching v with no neighbour, as (w1, w2) with (v, w1, w2) facing out.
   std::vector<std::array<int, 2>> fan;
   Vec3 area = Vec3::Zero();
   double scale = 0;
+  bool on_cut = false;
   for (int t : state.node_tets[v]) {
-    if (!state.cuttable[t]) return false;
+    if (!state.cuttable[t]) return NodeMove::kNone;
     const Tet& k = mesh.tets[t];
     for (int f = 0; f < 4; ++f) {
-      if (k[f] == v) continue;
+      if (k[f] == v) continue;  // the face opposite v does not touch it
       const bool open = neighbour_across(mesh, state, t, f).first < 0;
+      on_cut = on_cut || mesh.is_cut_face(t, f);
       if (!open) {
-        if (mesh.is_cut_face(t, f)) return false;  // a cut that has not opened here
+        if (mesh.is_cut_face(t, f)) return NodeMove::kNone;  // a cut that has not opened here
         continue;
       }
       std::array<int, 3> face = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
@@ -45,28 +34,34 @@ bool may_slide_on_plane(const TetMesh& mesh, const CutState& state, int v, Vec3&
       scale = std::max({scale, (a - x).norm(), (b - x).norm()});
     }
   }
-  if (fan.empty() || !(area.norm() > 0)) return false;
+  if (fan.empty()) return on_cut ? NodeMove::kNone : NodeMove::kInsideStar;
+  if (!(area.norm() > 0)) return NodeMove::kNone;
   normal = area.normalized();
   // Flat and facing one way.
   for (const auto& [a, b] : fan) {
     const Vec3 n = (mesh.nodes[a] - mesh.nodes[v]).cross(mesh.nodes[b] - mesh.nodes[v]);
-    if (!(n.dot(normal) > 0)) return false;
+    if (!(n.dot(normal) > 0)) return NodeMove::kNone;
     for (int w : {a, b})
-      if (std::abs(normal.dot(mesh.nodes[w] - mesh.nodes[v])) > 1e-9 * scale) return false;
+      if (std::abs(normal.dot(mesh.nodes[w] - mesh.nodes[v])) > 1e-9 * scale)
+        return NodeMove::kNone;
   }
   // One fan: its faces chained w1 -> w2 make a single cycle.
-  std::vector<std::array<int, 2>> chain = fan;
-  int at = chain.front()[1];
-  const int first = chain.front()[0];
+  int at = fan.front()[1];
+  const int first = fan.front()[0];
   size_t walked = 1;
-  while (at != first && walked < chain.size()) {
-    auto it = std::find_if(chain.begin(), chain.end(),
+  while (at != first && walked < fan.size()) {
+    auto it = std::find_if(fan.begin(), fan.end(),
                            [at](const std::array<int, 2>& e) { return e[0] == at; });
-    if (it == chain.end()) return false;
+    if (it == fan.end()) return NodeMove::kNone;
     at = (*it)[1];
     ++walked;
   }
-  return at == first && walked == chain.size();
+  return at == first && walked == fan.size() ? NodeMove::kInPlane : NodeMove::kNone;
+}
+
+bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v) {
+  Vec3 unused;
+  return how_node_may_move(mesh, state, v, unused) == NodeMove::kInsideStar;
 }
 
 double star_smallest_dihedral(const TetMesh& mesh, const CutState& state, int v, const Vec3& x,

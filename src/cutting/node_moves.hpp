@@ -14,20 +14,22 @@ namespace stc {
 // rest coordinates ~1e-12 apart).
 constexpr double kAngleRoundOffDeg = 1e-6;
 
-// May node v move inside its star: unlocked, every tet of the star cuttable, and no face of the
-// star that touches v on the boundary or on a cut? Then the star's outer faces are interior and
-// fixed, so wherever v goes while every star tet stays positive, the star tiles the same cavity:
-// no surface moves and the volume is exact.
-bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v);
+// How node v may move without moving any surface (docs/DESIGN.md section 8, "Smooth"):
+//  - kInsideStar: unlocked, every tet of its star cuttable, no face touching v on the boundary or
+//    on a cut. The star's outer faces are interior and fixed, so wherever v goes while every star
+//    tet stays positive, the star tiles the same cavity: the volume is exact.
+//  - kInPlane: unlocked, star cuttable, and the faces touching v that lie on the boundary (an
+//    opened cut's walls, the tissue's surface) form one fan, flat to round-off (every corner
+//    within 1e-9 of the star's scale of one plane, all facing one way), while no face touching v
+//    is a cut that has not opened. A move within that plane keeps the surface where it is (the
+//    fan still tiles the same flat polygon) and the volume exact; `normal` is set to the fan's
+//    unit normal.
+//  - kNone: neither.
+enum class NodeMove { kNone, kInsideStar, kInPlane };
+NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& normal);
 
-// May node v slide within a plane: unlocked, every tet of its star cuttable, and the faces of
-// its star that touch v and lie on the boundary (an opened cut's walls, the tissue's surface)
-// form one fan, flat to round-off (every corner within 1e-9 of the star's scale of one plane,
-// all facing one way), while no face touching v is a cut face that has not opened? Then a move
-// within that plane keeps the surface where it is (the fan still tiles the same flat polygon)
-// and the volume exact; `normal` is the fan's unit normal. Interior nodes are not "sliding"
-// ones (may_move_inside_star).
-bool may_slide_on_plane(const TetMesh& mesh, const CutState& state, int v, Vec3& normal);
+// how_node_may_move(...) == kInsideStar (a relocation onto the cut moves only such nodes).
+bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v);
 
 // The smallest dihedral angle (degrees) of v's star with v at x, or -1 when a tet of it would
 // keep no more than `guard` x its size class (or turn over).

@@ -36,9 +36,9 @@ struct CutOptions {
   // node keeps the total volume exactly (its star still tiles the same cavity).
   double relocate = 0.3;
   double relocate_min_dihedral_deg = 10.0;
-  // After each cut the nodes of the tets it left with a smallest dihedral angle below this
-  // (degrees) are moved inside their stars to raise it, where they may move (interior,
-  // unlocked, on no cut; cutting/cut_smoothing.hpp). 0: off.
+  // When a new stroke begins, the nodes of the tets the last stroke left with a smallest
+  // dihedral angle below this (degrees) are moved to raise it where no surface moves: inside
+  // their stars, or within a flat cut wall (cutting/cut_smoothing.hpp). 0: off.
   double smooth_below_deg = 10.0;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;

@@ -100,7 +100,7 @@ TEST(CutSmoothing, ANodeOnAFlatFaceSlidesWithinIt) {
   mesh.nodes[v] += Vec3(0.009, 0, 0);
   ASSERT_EQ(mesh.nodes[v].z(), 0.0);
   Vec3 normal;
-  ASSERT_TRUE(may_slide_on_plane(mesh, state, v, normal));
+  ASSERT_EQ(how_node_may_move(mesh, state, v, normal), NodeMove::kInPlane);
   EXPECT_FALSE(may_move_inside_star(mesh, state, v));
   EXPECT_NEAR(std::abs(normal.z()), 1.0, 1e-12);
   const double before = star_min_dihedral(mesh, state, v);
@@ -124,7 +124,7 @@ TEST(CutSmoothing, LockedAndEdgeNodesStay) {
   mesh.nodes[edge].x() += 0.008;
   mesh.nodes[inner] += Vec3(0.008, 0, 0);
   Vec3 normal;
-  EXPECT_FALSE(may_slide_on_plane(mesh, state, edge, normal));
+  EXPECT_EQ(how_node_may_move(mesh, state, edge, normal), NodeMove::kNone);
   EXPECT_FALSE(may_move_inside_star(mesh, state, inner));
   const TetMesh before = mesh;
   state.stroke_tets = state.node_tets[edge];
