@@ -236,6 +236,7 @@ void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>&
                          CutResult& result, std::set<FaceKey>& new_faces) {
   keep_slivers_attached(mesh, state, region_tets, new_faces);
   std::vector<Duplication> plan;
+  std::set<int> held_back;  // nodes left whole this time (their marks stay closed)
   for (;;) {
     // Nodes of still-closed marked faces: only their stars can fall apart.
     std::set<int> watch;
@@ -247,7 +248,7 @@ void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>&
     std::vector<int> locked_hits;
     for (int v : watch) {
       auto pieces = star_components(mesh, state, v);
-      if (pieces.size() < 2) continue;
+      if (pieces.size() < 2 || held_back.count(v)) continue;
       if (state.locked[v])
         locked_hits.push_back(v);
       else
@@ -265,6 +266,27 @@ void separate_along_cuts(TetMesh& mesh, CutState& state, const std::vector<int>&
     }
     const auto bad = planned_bad_edges(mesh, state, plan);
     if (bad.empty()) break;
+    // First leave whole the nodes whose duplication puts the bad edge into more boundary
+    // triangles: the third corners of the closed marks on it (and its own ends). Their marks
+    // stay closed, and open once later marks complete the surface around them.
+    bool held = false;
+    for (const auto& [p, q] : bad) {
+      std::vector<int> culprits = {p, q};
+      for (int t : tets_with_edge(state, p, q))
+        for (int f = 0; f < 4; ++f) {
+          if (!is_interior_marked(mesh, state, t, f)) continue;
+          const FaceKey key = face_key(mesh.tets[t], f);
+          if (std::find(key.begin(), key.end(), p) == key.end() ||
+              std::find(key.begin(), key.end(), q) == key.end())
+            continue;
+          for (int v : key)
+            if (v != p && v != q) culprits.push_back(v);
+        }
+      for (int v : culprits)
+        for (const Duplication& d : plan)
+          if (d.node == v && held_back.insert(v).second) held = true;
+    }
+    if (held) continue;
     int dropped = 0;
     for (const auto& [p, q] : bad) {
       int here = unmark_closed_faces(mesh, state, {p, q}, new_faces);

@@ -210,6 +210,15 @@ void measure_matrix(const std::string& mesh_name) {
           EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
           EXPECT_GE(fig.f.covered_area, 0.99 * fig.f.swept_area) << fig.line;
         }
+        // Issue 9 item 1's 90 % on every other stroke too, bar one: the thigh's slow curved
+        // vertical stroke (82.6 %: the tip's path is not conformed where the curved surface's
+        // extension below the tip runs through a node; README, limitations). The tilted
+        // curved strokes open through their creases since marks hanging on an opened wall's
+        // edge are held closed instead of dropped (separation.hpp; the thigh's 3 mm one opened
+        // 74.9 % before, 107 % now; the coarse liver's curved vertical 3 mm one 84.1 -> 93.2 %).
+        if (!(mesh_name == "thigh" && curved && tilt == 0 && step < 1e-3)) {
+          EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
+        }
       }
 }
 
