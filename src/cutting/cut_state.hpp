@@ -45,6 +45,13 @@ struct CutState {
   // Per node (grown on demand): moved onto a border of a cut once (split_along_border); it
   // is never moved there again.
   std::vector<std::uint8_t> moved_to_border;
+  // Per node (grown on demand): taken onto the current stroke's surface extended past one of
+  // its borders (a tet the border runs through is cut by a triangle's whole plane, and a
+  // crossing beyond the triangle moved this node onto that plane). Not on the cut - no face with
+  // such a corner opens - but an edge from it to a node on the cut lies along the surface, and
+  // where that edge crosses a border it is split there (split_along_border), also when a later
+  // triangle of a curved stroke, not coplanar with the one that took it, conforms that border.
+  std::vector<std::uint8_t> on_extension;
   // Where the last band's tip and heel paths ended (cut_band conforms them from there).
   std::array<Vec3, 2> border_from = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
   std::array<Vec3, 2> last_sweep_end = {Vec3::Constant(NAN), Vec3::Constant(NAN)};
@@ -73,6 +80,13 @@ inline void set_on_stroke(CutState& state, int v) {
   state.on_stroke[v] = 1;
 }
 
+inline bool is_on_extension(const CutState& state, int v) {
+  return static_cast<size_t>(v) < state.on_extension.size() && state.on_extension[v];
+}
+inline void set_on_extension(CutState& state, int v) {
+  if (state.on_extension.size() <= static_cast<size_t>(v)) state.on_extension.resize(v + 1, 0);
+  state.on_extension[v] = 1;
+}
 inline bool was_moved_to_border(const CutState& state, int v) {
   return static_cast<size_t>(v) < state.moved_to_border.size() && state.moved_to_border[v];
 }

@@ -68,6 +68,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     smooth_last_stroke(mesh, state, options, result);
     result.nodes_smoothed = static_cast<int>(result.moved_nodes.size());
     state.on_stroke.clear();
+    state.on_extension.clear();
   }
   std::set<FaceKey> new_faces;
   const long marked_before = count_marked_face_sides(mesh);

@@ -287,9 +287,15 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         const bool outside = !tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
                                            options.inside_tolerance);
         if (outside && !std::binary_search(whole.begin(), whole.end(), t)) continue;
-        auto put_on = [&](int node) {
+        // moved: relocated exactly onto the plane. A node beyond the triangle taken there
+        // (not one snapped in place, up to the snap distance off the plane) is on the
+        // surface's extension for the stroke's later triangles (cut_state.hpp).
+        auto put_on = [&](int node, bool moved) {
           tri.set_on(node);
-          if (!outside) set_on_stroke(state, node);
+          if (!outside)
+            set_on_stroke(state, node);
+          else if (moved)
+            set_on_extension(state, node);
         };
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
@@ -301,13 +307,13 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
           const int end = s < 0.5 ? u : v;
           if (relocate_node(mesh, state, end, mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
                             options, result)) {
-            put_on(end);
+            put_on(end, true);
             resnap = true;
             continue;
           }
         }
         if (s < options.snap_tolerance || s > 1 - options.snap_tolerance) {
-          put_on(s < 0.5 ? u : v);
+          put_on(s < 0.5 ? u : v, false);
           resnap = true;
           continue;
         }
@@ -407,7 +413,15 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   }
   std::sort(whole.begin(), whole.end());
   if (!whole.empty()) split_along_triangle(mesh, state, tri, options, result, whole);
-  // (b) The edges on the cut that cross the segment.
+  // (b) The edges on the cut that cross the segment. An end on the surface's extension past
+  // a border is on it as a node on the stroke is: within the snap distance of this triangle's
+  // plane (a curved stroke's earlier triangle, at a slight angle to this one, took it there).
+  auto on_cut_or_extension = [&](int v) {
+    if (tri.side(mesh, state, v) == 0) return true;
+    return is_on_extension(state, v) &&
+           std::abs(tri.distance(mesh, v)) <=
+               options.snap_tolerance * star_longest_edge(mesh, state, v);
+  };
   const std::vector<int> candidates =
       cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
   std::map<std::pair<int, int>, double> crossing;
@@ -417,7 +431,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
       const int u = std::min(tet[e[0]], tet[e[1]]), v = std::max(tet[e[0]], tet[e[1]]);
       if (crossing.count({u, v})) continue;
       if (state.locked[u] && state.locked[v]) continue;
-      if (tri.side(mesh, state, u) != 0 || tri.side(mesh, state, v) != 0) continue;
+      if (!on_cut_or_extension(u) || !on_cut_or_extension(v)) continue;
       const double du = across.dot(mesh.nodes[u] - p0), dv = across.dot(mesh.nodes[v] - p0);
       // An end on the border's line up to round-off is on the border already (an edge along
       // the line would otherwise "cross" it where its ends' noise signs differ).
