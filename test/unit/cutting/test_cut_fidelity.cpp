@@ -207,18 +207,15 @@ void measure_matrix(const std::string& mesh_name) {
         // no hole (the thigh's 3 mm stroke left a 9.4 mm one along the tip's path without them;
         // measured 107-143 % opened, 100 % covered).
         if (!curved && tilt == 0) {
-          EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
           EXPECT_GE(fig.f.covered_area, 0.99 * fig.f.swept_area) << fig.line;
         }
-        // Issue 9 item 1's 90 % on every other stroke too, bar one: the thigh's slow curved
-        // vertical stroke (82.6 %: the tip's path is not conformed where the curved surface's
-        // extension below the tip runs through a node; README, limitations). The tilted
-        // curved strokes open through their creases since marks hanging on an opened wall's
-        // edge are held closed instead of dropped (separation.hpp; the thigh's 3 mm one opened
-        // 74.9 % before, 107 % now; the coarse liver's curved vertical 3 mm one 84.1 -> 93.2 %).
-        if (!(mesh_name == "thigh" && curved && tilt == 0 && step < 1e-3)) {
-          EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
-        }
+        // Issue 9 item 1's 90 % on every stroke (stop 37; least 93.2 %, the 12k liver's curved
+        // vertical 3 mm stroke). The tilted curved strokes open through their creases since
+        // marks hanging on an opened wall's edge are held closed instead of dropped
+        // (separation.hpp; the thigh's 3 mm one 74.9 -> 107 %), the slow curved ones up to the
+        // tip since nodes on the surface's extension count on a later band's border
+        // (cut_state.hpp, on_extension; the thigh's vertical 0.2 mm one 82.6 -> 106 %).
+        EXPECT_GE(fig.f.opening(), 0.9) << fig.line;
       }
 }
 
