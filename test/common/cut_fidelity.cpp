@@ -156,13 +156,16 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
     face_tree.build(boxes);
   }
   std::vector<Vec3> points;
-  for (const SweptTriangle& s : sweep) {
+  out.swept_by_triangle.assign(sweep.size(), 0.0);
+  out.covered_by_triangle.assign(sweep.size(), 0.0);
+  for (size_t k = 0; k < sweep.size(); ++k) {
     double weight = 0;
-    sample_triangle(s.x, spacing, points, weight);
+    sample_triangle(sweep[k].x, spacing, points, weight);
     for (const Vec3& p : points) {
       double h = 0;
       if (!region.contains(p, &h)) continue;
       out.swept_area += weight;
+      out.swept_by_triangle[k] += weight;
       // Nearest face: search growing boxes around p until one holds a face that is nearer
       // than the box's half-width (then no face outside it can be nearer).
       double best = INFINITY;
@@ -175,7 +178,7 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
         }
       }
       if (!std::isfinite(best)) best = 2.0;  // nothing opened near: 2 m stands for "no face"
-      if (best <= tolerance_at(h)) out.covered_area += weight;
+      if (best <= tolerance_at(h)) out.covered_area += weight, out.covered_by_triangle[k] += weight;
       if (best > out.sweep_to_faces) out.sweep_to_faces = best, out.worst_swept_point = p;
       out.hausdorff_over_tolerance = std::max(out.hausdorff_over_tolerance, best / tolerance_at(h));
     }

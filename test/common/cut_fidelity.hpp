@@ -58,6 +58,9 @@ struct CutFidelity {
                                           // from the swept surface
   double wall_alignment = 0;              // area-weighted mean |n_face . n_blade|
   int open_cut_faces = 0;                 // in the region
+  // Per sweep triangle (same order): its swept area in the region and how much of that is
+  // within tolerance of an open face (m^2; the sums are swept_area and covered_area).
+  std::vector<double> swept_by_triangle, covered_by_triangle;
   // min(opened_area) / swept_area (0 when nothing was swept).
   double opening() const {
     return swept_area > 0 ? std::min(opened_area[0], opened_area[1]) / swept_area : 0;
