@@ -54,4 +54,9 @@ std::vector<int> tets_near(const TetMesh& mesh, const TetGrid& grid, const Vec3&
   return grid.query(mesh, p - r, p + r);
 }
 
+bool any_tet_near(const TetMesh& mesh, const TetGrid& grid, const Vec3& p, double reach) {
+  const Vec3 r = Vec3::Constant(reach);
+  return grid.any(mesh, p - r, p + r);
+}
+
 }  // namespace stc

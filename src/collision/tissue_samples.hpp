@@ -27,5 +27,7 @@ int tet_containing(const TetMesh& mesh, const TetGrid& grid, const Vec3& p);
 // The tets listed in `grid` whose rest box overlaps the cube of half-size `reach` around p
 // (a superset of the tets within `reach` of p).
 std::vector<int> tets_near(const TetMesh& mesh, const TetGrid& grid, const Vec3& p, double reach);
+// Whether tets_near would list any tet (without listing them).
+bool any_tet_near(const TetMesh& mesh, const TetGrid& grid, const Vec3& p, double reach);
 
 }  // namespace stc

@@ -6,9 +6,8 @@
 
 namespace stc {
 
-void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+void DeformedToRest::build(const TetMesh& mesh, const Eigen::VectorXd& displacement,
                            const std::vector<std::uint8_t>& include) {
-  // Only the included tets are kept (the operation part: a few thousand of the organ's 70k).
   std::vector<int> tets;
   for (size_t t = 0; t < mesh.tets.size(); ++t)
     if (include.empty() || include[t]) tets.push_back(static_cast<int>(t));
@@ -16,19 +15,36 @@ void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displac
   build(mesh, displacement, tets, -everywhere, everywhere);
 }
 
-void DeformedToRest::build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+void DeformedToRest::build(const TetMesh& mesh, const Eigen::VectorXd& displacement,
                            const std::vector<int>& tets, const Vec3& lo, const Vec3& hi) {
-  mesh_.nodes = mesh.nodes;
-  mesh_.tets.clear();
-  std::vector<Vec3> x(mesh.nodes.size());
-  for (size_t i = 0; i < x.size(); ++i) x[i] = mesh.nodes[i] + displacement[i];
+  // Only the kept tets and their nodes are copied, renumbered: a cut step's map holds a few
+  // hundred tets of a mesh of tens of thousands of nodes, and is rebuilt at every cut.
+  const auto deformed = [&](int v) -> Vec3 {
+    return mesh.nodes[static_cast<size_t>(v)] + displacement.segment<3>(3 * v);
+  };
+  std::vector<Tet> kept;
   for (int t : tets) {
     const Tet& k = mesh.tets[static_cast<size_t>(t)];
-    const Vec3 t_lo = x[k[0]].cwiseMin(x[k[1]]).cwiseMin(x[k[2]]).cwiseMin(x[k[3]]);
-    const Vec3 t_hi = x[k[0]].cwiseMax(x[k[1]]).cwiseMax(x[k[2]]).cwiseMax(x[k[3]]);
-    if ((t_lo.array() <= hi.array()).all() && (t_hi.array() >= lo.array()).all())
-      mesh_.tets.push_back(k);
+    const Vec3 x0 = deformed(k[0]), x1 = deformed(k[1]), x2 = deformed(k[2]), x3 = deformed(k[3]);
+    const Vec3 t_lo = x0.cwiseMin(x1).cwiseMin(x2).cwiseMin(x3);
+    const Vec3 t_hi = x0.cwiseMax(x1).cwiseMax(x2).cwiseMax(x3);
+    if ((t_lo.array() <= hi.array()).all() && (t_hi.array() >= lo.array()).all()) kept.push_back(k);
   }
+  std::vector<int> used;
+  used.reserve(4 * kept.size());
+  for (const Tet& k : kept) used.insert(used.end(), k.begin(), k.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  mesh_.nodes.resize(used.size());
+  std::vector<Vec3> x(used.size());
+  for (size_t i = 0; i < used.size(); ++i) {
+    mesh_.nodes[i] = mesh.nodes[static_cast<size_t>(used[i])];
+    x[i] = deformed(used[i]);
+  }
+  mesh_.tets = std::move(kept);
+  for (Tet& k : mesh_.tets)
+    for (int& v : k)
+      v = static_cast<int>(std::lower_bound(used.begin(), used.end(), v) - used.begin());
   locator_.build(mesh_, std::move(x));
 }
 

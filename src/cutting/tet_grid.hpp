@@ -19,6 +19,9 @@ class TetGrid {
   void insert(const TetMesh& mesh, int tet);
   // Listed tets whose box overlaps [lo, hi], ascending and unique.
   std::vector<int> query(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const;
+  // Whether query() would list any tet: stops at the first (no list, no sort). The moving
+  // region asks this for every sample of a sweep at every cutting step.
+  bool any(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const;
 
  private:
   std::array<int, 3> cell_of(const Vec3& p) const;

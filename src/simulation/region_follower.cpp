@@ -52,13 +52,13 @@ bool RegionFollower::inside_tissue(const HybridModel& model, const CutState& cut
 
 bool RegionFollower::near_tissue(const HybridModel& model, const CutState& cut, const Vec3& p,
                                  double reach) const {
-  return !tets_near(model.mesh(), cut.grid, p, reach).empty() ||
-         !tets_near(model.mesh(), condensed_grid_, p, reach).empty();
+  return any_tet_near(model.mesh(), cut.grid, p, reach) ||
+         any_tet_near(model.mesh(), condensed_grid_, p, reach);
 }
 
 bool RegionFollower::clear_at(const HybridModel& model, const CutState& cut, const Vec3& p,
                               double reach) const {
-  if (!tets_near(model.mesh(), condensed_grid_, p, reach).empty()) return false;
+  if (any_tet_near(model.mesh(), condensed_grid_, p, reach)) return false;
   const Partition& part = model.partition();
   for (int t : tets_near(model.mesh(), cut.grid, p, reach)) {
     if (!cut.cuttable[static_cast<size_t>(t)]) return false;
@@ -89,7 +89,7 @@ std::string RegionFollower::edge_clearance(const HybridModel& model, const CutSt
                                            const BladeEdge& edge) const {
   const double reach = spacing_ + kReach * stats_.ball.radius;
   for (const Vec3& p : edge_points(edge)) {
-    if (!tets_near(model.mesh(), condensed_grid_, p, spacing_).empty())
+    if (any_tet_near(model.mesh(), condensed_grid_, p, spacing_))
       return "the blade reached condensed tissue";
     if (!clear_at(model, cut, p, reach))
       return "the blade is within one element layer (plus look-ahead) of the interface";

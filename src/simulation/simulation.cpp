@@ -239,7 +239,8 @@ struct Simulation::Impl {
       const Vec3& lo = Vec3::Constant(-std::numeric_limits<double>::infinity()),
       const Vec3& hi = Vec3::Constant(std::numeric_limits<double>::infinity())) const {
     auto map = std::make_shared<DeformedToRest>();
-    map->build(model->mesh(), displacements(), model->partition().operation_tets, lo, hi);
+    map->build(model->mesh(), model->operation_displacement(), model->partition().operation_tets,
+               lo, hi);
     return map;
   }
 
@@ -252,7 +253,7 @@ struct Simulation::Impl {
   std::shared_ptr<DeformedToRest> path_to_rest() const {
     if (!follower) return current_to_rest();
     auto map = std::make_shared<DeformedToRest>();
-    map->build(model->mesh(), per_node(model->displacement()));  // every tet
+    map->build(model->mesh(), model->displacement());  // every tet
     return map;
   }
 

@@ -20,18 +20,18 @@ class DeformedToRest {
   DeformedToRest() = default;
   DeformedToRest(const DeformedToRest&) = delete;  // the locator points at mesh_
   DeformedToRest& operator=(const DeformedToRest&) = delete;
-  // displacement: per node; include: per tet, nonzero = the tets whose displacement is
+  // displacement: 3 per node (x, y, z); include: per tet, nonzero = the tets whose displacement is
   // current (the operation part; empty = all). The rest nodes and tets are copied, so the map
   // stays valid while the mesh is cut: a ~cut path is carried through the deformation it was
   // requested in, however many steps run between its slices (simulation.hpp, PathCut).
-  void build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+  void build(const TetMesh& mesh, const Eigen::VectorXd& displacement,
              const std::vector<std::uint8_t>& include = {});
   // The same over `tets` (indices into mesh.tets, e.g. the operation part's list), keeping
   // only those whose deformed box overlaps [lo, hi]: enough for points in that box (a cut
   // step's edges: a few hundred tets instead of the operation part's thousands, and the
   // organ's 71k never scanned; rebuilt at every cut).
-  void build(const TetMesh& mesh, const std::vector<Vec3>& displacement,
-             const std::vector<int>& tets, const Vec3& lo, const Vec3& hi);
+  void build(const TetMesh& mesh, const Eigen::VectorXd& displacement, const std::vector<int>& tets,
+             const Vec3& lo, const Vec3& hi);
   // The rest position of deformed point x, or nothing when x is in no included tet.
   std::optional<Vec3> map(const Vec3& x) const;
   // The edge tip -> heel sampled at parameters s (ascending in [0, 1]) and carried to rest.
@@ -40,7 +40,7 @@ class DeformedToRest {
                                             const std::vector<double>& s) const;
 
  private:
-  TetMesh mesh_;        // rest nodes and tets as built (no cut flags)
+  TetMesh mesh_;        // the kept tets and their rest nodes, renumbered (no cut flags)
   TetLocator locator_;  // over deformed positions
 };
 
