@@ -8,4 +8,5 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_cut_smoothing.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
   test/unit/cutting/test_earlier_triangles.cpp
+  test/unit/cutting/test_tet_grid.cpp
 )
