@@ -69,11 +69,14 @@ int worst_tet(const TetMesh& mesh, const CutState& state, int v, const Vec3& x) 
 // ascent on the worst tet's smallest angle (its gradient by central differences) with a step
 // that grows on success and halves on failure; q is non-smooth where two tets tie, which the
 // step's acceptance test (q itself, not the worst tet's angle) handles. Returns the best x.
-// A boundary node's moves are projected onto its fan's plane (plane_normal; zero: free).
-Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double guard,
-                   const Vec3& plane_normal, double& quality) {
-  const auto in_plane = [&plane_normal](const Vec3& d) -> Vec3 {
-    return d - plane_normal * plane_normal.dot(d);
+// A boundary node's moves are projected onto its fan's plane or its crease's line (how, axis:
+// how_node_may_move's).
+Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double guard, NodeMove how,
+                   const Vec3& axis, double& quality) {
+  const auto in_plane = [how, &axis](const Vec3& d) -> Vec3 {
+    if (how == NodeMove::kInPlane) return d - axis * axis.dot(d);
+    if (how == NodeMove::kOnLine) return axis * axis.dot(d);
+    return d;
   };
   const Vec3 start = mesh.nodes[v];
   double shortest = 1e300;
@@ -155,14 +158,16 @@ void smooth_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
     }
     bool moved = false;
     for (int v : nodes) {
-      Vec3 normal = Vec3::Zero();  // stays zero for a move inside the star
-      if (how_node_may_move(mesh, state, v, normal) == NodeMove::kNone) continue;
+      Vec3 axis = Vec3::Zero();
+      const NodeMove how = how_node_may_move(mesh, state, v, axis);
+      if (how == NodeMove::kNone) continue;
       const double before = star_smallest_dihedral(mesh, state, v, mesh.nodes[v], -1e300);
       double after = before;
-      const Vec3 x = best_position(mesh, state, v, guard, normal, after);
+      const Vec3 x = best_position(mesh, state, v, guard, how, axis, after);
       if (!(after > before + kMoveGainDeg)) continue;
-      // The star's volume is affine in x_v with a gradient along the fan's normal (zero inside):
-      // a move that changes it beyond round-off is refused (docs/SCENE.md "Cut invariants" 2).
+      // The star's volume is affine in x_v with a gradient normal to the fan's plane, or to the
+      // crease's line (zero inside): a move that changes it beyond round-off is refused
+      // (docs/SCENE.md "Cut invariants" 2).
       const double volume = star_volume(mesh, state, v, mesh.nodes[v]);
       if (std::abs(star_volume(mesh, state, v, x) - volume) > 1e-12 * volume) continue;
       move_node(mesh, state, v, x, result);

@@ -8,7 +8,7 @@
 
 namespace stc {
 
-NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& normal) {
+NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& axis) {
   if (state.locked[v]) return NodeMove::kNone;
   // The fan: faces touching v with no neighbour, as (w1, w2) with (v, w1, w2) facing out.
   std::vector<std::array<int, 2>> fan;
@@ -36,27 +36,52 @@ NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Ve
   }
   if (fan.empty()) return on_cut ? NodeMove::kNone : NodeMove::kInsideStar;
   if (!(area.norm() > 0)) return NodeMove::kNone;
-  normal = area.normalized();
-  // Flat and facing one way.
-  for (const auto& [a, b] : fan) {
-    const Vec3 n = (mesh.nodes[a] - mesh.nodes[v]).cross(mesh.nodes[b] - mesh.nodes[v]);
-    if (!(n.dot(normal) > 0)) return NodeMove::kNone;
-    for (int w : {a, b})
-      if (std::abs(normal.dot(mesh.nodes[w] - mesh.nodes[v])) > 1e-9 * scale)
-        return NodeMove::kNone;
+  // The fan's faces in the plane through v with unit normal n, facing along n: all of them
+  // (kInPlane), or all but those in a second such plane (kOnLine, the crease where a cut's wall
+  // meets another wall or a flat skin).
+  const auto in_plane = [&](const std::array<int, 2>& face, const Vec3& n) {
+    const Vec3 m = (mesh.nodes[face[0]] - mesh.nodes[v]).cross(mesh.nodes[face[1]] - mesh.nodes[v]);
+    if (!(m.dot(n) > 0)) return false;
+    for (int w : face)
+      if (std::abs(n.dot(mesh.nodes[w] - mesh.nodes[v])) > 1e-9 * scale) return false;
+    return true;
+  };
+  const auto face_normal = [&](const std::array<int, 2>& face) -> Vec3 {
+    return (mesh.nodes[face[0]] - mesh.nodes[v])
+        .cross(mesh.nodes[face[1]] - mesh.nodes[v])
+        .normalized();
+  };
+  NodeMove kind = NodeMove::kNone;
+  axis = area.normalized();
+  if (std::all_of(fan.begin(), fan.end(), [&](const auto& f) { return in_plane(f, axis); })) {
+    kind = NodeMove::kInPlane;
+  } else {
+    const Vec3 first = face_normal(fan.front());
+    std::vector<std::array<int, 2>> rest;
+    for (const auto& f : fan)
+      if (!in_plane(f, first)) rest.push_back(f);
+    if (rest.empty()) return NodeMove::kNone;
+    const Vec3 second = face_normal(rest.front());
+    const Vec3 line = first.cross(second);
+    // Two planes at an angle (a line well defined), every other face in the second one.
+    if (!(line.norm() > 1e-3) ||
+        !std::all_of(rest.begin(), rest.end(), [&](const auto& f) { return in_plane(f, second); }))
+      return NodeMove::kNone;
+    axis = line.normalized();
+    kind = NodeMove::kOnLine;
   }
   // One fan: its faces chained w1 -> w2 make a single cycle.
   int at = fan.front()[1];
-  const int first = fan.front()[0];
+  const int start = fan.front()[0];
   size_t walked = 1;
-  while (at != first && walked < fan.size()) {
+  while (at != start && walked < fan.size()) {
     auto it = std::find_if(fan.begin(), fan.end(),
                            [at](const std::array<int, 2>& e) { return e[0] == at; });
     if (it == fan.end()) return NodeMove::kNone;
     at = (*it)[1];
     ++walked;
   }
-  return at == first && walked == fan.size() ? NodeMove::kInPlane : NodeMove::kNone;
+  return at == start && walked == fan.size() ? kind : NodeMove::kNone;
 }
 
 bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v) {

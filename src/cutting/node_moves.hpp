@@ -23,10 +23,16 @@ constexpr double kAngleRoundOffDeg = 1e-6;
 //    within 1e-9 of the star's scale of one plane, all facing one way), while no face touching v
 //    is a cut that has not opened. A move within that plane keeps the surface where it is (the
 //    fan still tiles the same flat polygon) and the volume exact; `normal` is set to the fan's
-//    unit normal.
-//  - kNone: neither.
-enum class NodeMove { kNone, kInsideStar, kInPlane };
-NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& normal);
+//    unit normal (`axis`).
+//  - kOnLine: as kInPlane, but the boundary faces touching v form two flat fans in two planes
+//    at an angle (the crease where an opened cut's wall meets another wall or a flat stretch of
+//    the tissue's surface). A move along the planes' common line keeps each fan in its plane
+//    and the volume exact; `axis` is set to the line's unit direction. Most nodes of the thin
+//    tets a cut leaves lie on such creases (random sweeps on the thigh, box and a liver: 59 %
+//    of their corners that could not move otherwise).
+//  - kNone: none of these.
+enum class NodeMove { kNone, kInsideStar, kInPlane, kOnLine };
+NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& axis);
 
 // how_node_may_move(...) == kInsideStar (a relocation onto the cut moves only such nodes).
 bool may_move_inside_star(const TetMesh& mesh, const CutState& state, int v);

@@ -113,25 +113,47 @@ TEST(CutSmoothing, ANodeOnAFlatFaceSlidesWithinIt) {
   EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area);
 }
 
-TEST(CutSmoothing, LockedAndEdgeNodesStay) {
+TEST(CutSmoothing, ANodeOnAnEdgeSlidesAlongIt) {
   TetMesh mesh = box();
-  // A node on an edge of the box (its fan is two faces at 90 deg) and a locked interior one.
-  const int edge = node_at(mesh, Vec3(0.03, 0.0, 0.0));
+  CutState state = make_cut_state(mesh, {}, {});
+  const double volume = total_volume(mesh);
+  const double area = surface_area(mesh);
+  // A node of the box's edge y = z = 0 (its fan: two flat fans at 90 deg), pushed along it.
+  const int v = node_at(mesh, Vec3(0.03, 0.0, 0.0));
+  mesh.nodes[v].x() += 0.009;
+  Vec3 axis;
+  ASSERT_EQ(how_node_may_move(mesh, state, v, axis), NodeMove::kOnLine);
+  EXPECT_NEAR(std::abs(axis.x()), 1.0, 1e-12);
+  const double before = star_min_dihedral(mesh, state, v);
+  smooth_star(mesh, state, v);
+  const double after = star_min_dihedral(mesh, state, v);
+  std::printf("edge node: star's smallest dihedral %.2f -> %.2f deg\n", before, after);
+  EXPECT_GT(after, before + 5.0);
+  EXPECT_EQ(mesh.nodes[v].y(), 0.0);  // still on its edge
+  EXPECT_EQ(mesh.nodes[v].z(), 0.0);
+  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
+  EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area);
+}
+
+TEST(CutSmoothing, LockedAndCornerNodesStay) {
+  TetMesh mesh = box();
+  // A corner of the box (three planes meet there: no line keeps it on all) and a locked
+  // interior node.
+  const int corner = node_at(mesh, Vec3(0.0, 0.0, 0.0));
   const int inner = node_at(mesh, Vec3(0.02, 0.02, 0.02));
   std::vector<std::uint8_t> locked(mesh.nodes.size(), 0);
   locked[inner] = 1;
   CutState state = make_cut_state(mesh, locked, {});
-  mesh.nodes[edge].x() += 0.008;
   mesh.nodes[inner] += Vec3(0.008, 0, 0);
-  Vec3 normal;
-  EXPECT_EQ(how_node_may_move(mesh, state, edge, normal), NodeMove::kNone);
+  Vec3 axis;
+  EXPECT_EQ(how_node_may_move(mesh, state, corner, axis), NodeMove::kNone);
   EXPECT_FALSE(may_move_inside_star(mesh, state, inner));
   const TetMesh before = mesh;
-  state.stroke_tets = state.node_tets[edge];
+  state.stroke_tets = state.node_tets[corner];
   for (int t : state.node_tets[inner]) state.stroke_tets.push_back(t);
   CutResult r;
   smooth_last_stroke(mesh, state, CutOptions{}, r);
-  EXPECT_EQ(mesh.nodes[edge], before.nodes[edge]);
+  EXPECT_EQ(mesh.nodes[corner], before.nodes[corner]);
   EXPECT_EQ(mesh.nodes[inner], before.nodes[inner]);
 }
 
