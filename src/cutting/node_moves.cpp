@@ -10,66 +10,64 @@ namespace stc {
 
 NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Vec3& axis) {
   if (state.locked[v]) return NodeMove::kNone;
-  // The fan: faces touching v with no neighbour, as (w1, w2) with (v, w1, w2) facing out.
-  std::vector<std::array<int, 2>> fan;
-  Vec3 area = Vec3::Zero();
+  // The faces touching v that must stay where they are, as (w1, w2) with (v, w1, w2) facing
+  // out of the tet: those with no neighbour (the fan) and the cuts that have not opened.
+  std::vector<std::array<int, 2>> fan, closed;
   double scale = 0;
-  bool on_cut = false;
   for (int t : state.node_tets[v]) {
     if (!state.cuttable[t]) return NodeMove::kNone;
     const Tet& k = mesh.tets[t];
     for (int f = 0; f < 4; ++f) {
       if (k[f] == v) continue;  // the face opposite v does not touch it
       const bool open = neighbour_across(mesh, state, t, f).first < 0;
-      on_cut = on_cut || mesh.is_cut_face(t, f);
-      if (!open) {
-        if (mesh.is_cut_face(t, f)) return NodeMove::kNone;  // a cut that has not opened here
-        continue;
-      }
+      if (!open && !mesh.is_cut_face(t, f)) continue;
       std::array<int, 3> face = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
       while (face[0] != v) std::rotate(face.begin(), face.begin() + 1, face.end());
-      fan.push_back({face[1], face[2]});
-      const Vec3 &x = mesh.nodes[v], &a = mesh.nodes[face[1]], &b = mesh.nodes[face[2]];
-      area += (a - x).cross(b - x);
-      scale = std::max({scale, (a - x).norm(), (b - x).norm()});
+      (open ? fan : closed).push_back({face[1], face[2]});
+      scale = std::max({scale, (mesh.nodes[face[1]] - mesh.nodes[v]).norm(),
+                        (mesh.nodes[face[2]] - mesh.nodes[v]).norm()});
     }
   }
-  if (fan.empty()) return on_cut ? NodeMove::kNone : NodeMove::kInsideStar;
-  if (!(area.norm() > 0)) return NodeMove::kNone;
-  // The fan's faces in the plane through v with unit normal n, facing along n: all of them
-  // (kInPlane), or all but those in a second such plane (kOnLine, the crease where a cut's wall
-  // meets another wall or a flat skin).
-  const auto in_plane = [&](const std::array<int, 2>& face, const Vec3& n) {
-    const Vec3 m = (mesh.nodes[face[0]] - mesh.nodes[v]).cross(mesh.nodes[face[1]] - mesh.nodes[v]);
-    if (!(m.dot(n) > 0)) return false;
+  if (fan.empty() && closed.empty()) return NodeMove::kInsideStar;
+  const Vec3& x = mesh.nodes[v];
+  const auto normal_of = [&](const std::array<int, 2>& face) -> Vec3 {
+    return (mesh.nodes[face[0]] - x).cross(mesh.nodes[face[1]] - x);
+  };
+  const auto lies_in = [&](const std::array<int, 2>& face, const Vec3& n) {
     for (int w : face)
-      if (std::abs(n.dot(mesh.nodes[w] - mesh.nodes[v])) > 1e-9 * scale) return false;
+      if (std::abs(n.dot(mesh.nodes[w] - x)) > 1e-9 * scale) return false;
     return true;
   };
-  const auto face_normal = [&](const std::array<int, 2>& face) -> Vec3 {
-    return (mesh.nodes[face[0]] - mesh.nodes[v])
-        .cross(mesh.nodes[face[1]] - mesh.nodes[v])
-        .normalized();
-  };
-  NodeMove kind = NodeMove::kNone;
-  axis = area.normalized();
-  if (std::all_of(fan.begin(), fan.end(), [&](const auto& f) { return in_plane(f, axis); })) {
-    kind = NodeMove::kInPlane;
-  } else {
-    const Vec3 first = face_normal(fan.front());
-    std::vector<std::array<int, 2>> rest;
-    for (const auto& f : fan)
-      if (!in_plane(f, first)) rest.push_back(f);
-    if (rest.empty()) return NodeMove::kNone;
-    const Vec3 second = face_normal(rest.front());
-    const Vec3 line = first.cross(second);
-    // Two planes at an angle (a line well defined), every other face in the second one.
-    if (!(line.norm() > 1e-3) ||
-        !std::all_of(rest.begin(), rest.end(), [&](const auto& f) { return in_plane(f, second); }))
-      return NodeMove::kNone;
+  // The planes through v (unit normals) that hold those faces, to round-off (1e-9 of the
+  // star's scale): one (kInPlane: a flat fan or cut), or two at an angle (kOnLine: the crease
+  // where a cut meets another cut or a flat stretch of the tissue's surface); the open faces
+  // of one plane all face one way.
+  std::vector<Vec3> planes;
+  std::vector<int> facing;  // per plane: +1 / -1 the open faces' side, 0 none yet
+  for (const auto* faces : {&fan, &closed})
+    for (const auto& face : *faces) {
+      size_t p = 0;
+      while (p < planes.size() && !lies_in(face, planes[p])) ++p;
+      if (p == planes.size()) {
+        const Vec3 n = normal_of(face);
+        if (!(n.norm() > 0) || planes.size() == 2) return NodeMove::kNone;
+        planes.push_back(n.normalized());
+        facing.push_back(0);
+      }
+      if (faces == &closed) continue;
+      const int side = normal_of(face).dot(planes[p]) > 0 ? 1 : -1;
+      if (facing[p] != 0 && facing[p] != side) return NodeMove::kNone;
+      facing[p] = side;
+    }
+  NodeMove kind = NodeMove::kInPlane;
+  axis = planes[0];
+  if (planes.size() == 2) {
+    const Vec3 line = planes[0].cross(planes[1]);
+    if (!(line.norm() > 1e-3)) return NodeMove::kNone;  // nearly parallel: no line to keep
     axis = line.normalized();
     kind = NodeMove::kOnLine;
   }
+  if (fan.empty()) return kind;
   // One fan: its faces chained w1 -> w2 make a single cycle.
   int at = fan.front()[1];
   const int start = fan.front()[0];

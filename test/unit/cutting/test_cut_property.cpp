@@ -368,9 +368,10 @@ TEST(CutProperty, QualityAfter100Cuts) {
   // (-14 %), liver 476 -> 467 (-2 %; seeds 1 and 3 more with it: the smoothing changes which
   // sweeps cut, 67-77 of 100), box seed 99 smoothed min 0.39 deg. The smoothing's gain is
   // within the seeds' scatter on one specimen, so it is asserted over all twelve runs.
-  // Stop 38 (nodes on a crease of two flat fans slide along it, node_moves.hpp kOnLine): with
-  // smoothing thigh 641 -> 551, box 645 -> 478, liver 467 -> 429; against none, 2061 -> 1458
-  // (-29 %, was -15 %). Asserted: at least a fifth fewer.
+  // Stop 38 (nodes on a crease slide along it, nodes on a cut that has not opened slide within
+  // its plane: node_moves.hpp): with smoothing thigh 641 -> 497, box 645 -> 428, liver 467 ->
+  // 317; against none, 2061 -> 1242 (-40 %, was -15 %; smoothed minima 0.50-1.80 deg).
+  // Asserted: at least a quarter fewer.
   std::array<int, 2> thin = {0, 0};
   for (const auto& [specimen, min_ratio] :
        {std::make_pair(thigh_specimen(), 0.0008), std::make_pair(box_specimen(), 0.0012),
@@ -380,7 +381,7 @@ TEST(CutProperty, QualityAfter100Cuts) {
     thin[1] += here[1];
   }
   std::printf("all specimens: tets under 5 deg %d -> %d smoothed\n", thin[0], thin[1]);
-  EXPECT_LE(thin[1], 0.8 * thin[0]) << "the smoothing removes at least a fifth of the thin tets";
+  EXPECT_LE(thin[1], 0.75 * thin[0]) << "the smoothing removes at least a quarter of the thin tets";
 }
 
 }  // namespace

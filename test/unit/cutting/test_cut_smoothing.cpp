@@ -135,6 +135,42 @@ TEST(CutSmoothing, ANodeOnAnEdgeSlidesAlongIt) {
   EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area);
 }
 
+TEST(CutSmoothing, ANodeOnACutThatHasNotOpenedSlidesWithinIt) {
+  TetMesh mesh = box();
+  CutState state = make_cut_state(mesh, {}, {});
+  const double volume = total_volume(mesh);
+  // An interior node with the faces around it in the plane z = 0.03 marked as a cut that has
+  // not opened (both tets' bits, as a held-closed mark leaves them), pushed within the plane.
+  const int v = node_at(mesh, Vec3(0.03, 0.03, 0.03));
+  const double z = mesh.nodes[v].z();
+  int marked = 0;
+  for (int t : state.node_tets[v])
+    for (int f = 0; f < 4; ++f) {
+      const Tet& k = mesh.tets[t];
+      if (k[f] == v) continue;
+      bool flat = true;
+      for (int i = 0; i < 3; ++i) flat = flat && mesh.nodes[k[kTetFaces[f][i]]].z() == z;
+      if (!flat || mesh.is_cut_face(t, f)) continue;
+      const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+      ASSERT_GE(other, 0);
+      mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
+      mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
+      ++marked;
+    }
+  ASSERT_GE(marked, 4);  // a fan around v
+  mesh.nodes[v] += Vec3(0.009, 0, 0);
+  Vec3 axis;
+  ASSERT_EQ(how_node_may_move(mesh, state, v, axis), NodeMove::kInPlane);
+  EXPECT_NEAR(std::abs(axis.z()), 1.0, 1e-12);
+  const double before = star_min_dihedral(mesh, state, v);
+  smooth_star(mesh, state, v);
+  const double after = star_min_dihedral(mesh, state, v);
+  std::printf("node on a closed cut: star's smallest dihedral %.2f -> %.2f deg\n", before, after);
+  EXPECT_GT(after, before + 5.0);
+  EXPECT_EQ(mesh.nodes[v].z(), z);  // the marked faces stay in their plane
+  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
+}
+
 TEST(CutSmoothing, LockedAndCornerNodesStay) {
   TetMesh mesh = box();
   // A corner of the box (three planes meet there: no line keeps it on all) and a locked
