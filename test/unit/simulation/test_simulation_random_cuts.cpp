@@ -182,8 +182,8 @@ int stroke_count(int ci_default) {
 // stroke carried to rest coordinates through the sag. After every stroke: docs/SCENE.md "Cut
 // invariants", an SPD system on the free DOF, a finite solution. The smallest dihedral angle and
 // the CG iterations of the solve after each stroke are reported after 100 strokes and at the end
-// (issue 9 item 4 asks for >= 5 deg and <= 2x the uncut mesh's iterations; see README, not yet
-// met).
+// (issue 9 item 4 asks for >= 5 deg, not met - see README - and <= 2x the uncut mesh's
+// iterations, met and asserted).
 TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   const int strokes = stroke_count(300);
   ASSERT_GT(strokes, 0) << "TISSUE_RANDOM_CUT_STROKES must be a positive number";
@@ -198,6 +198,8 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   std::vector<int> iterations;
   int not_converged = 0;
   double worst_residual = 0;
+  int thin_at_100 = -1;
+  double dihedral_at_100 = 0;
   const auto report = [&](int done) {
     std::vector<int> sorted = iterations;
     std::sort(sorted.begin(), sorted.end());
@@ -215,6 +217,10 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
         mesh_quality(sim.mesh()).min_dihedral_deg, thin, sorted[sorted.size() / 2], sorted.back(),
         cold_iterations, not_converged, worst_residual);
     std::fflush(stdout);
+    if (done == 100) {
+      thin_at_100 = thin;
+      dihedral_at_100 = mesh_quality(sim.mesh()).min_dihedral_deg;
+    }
   };
   for (int k = 0; k < strokes; ++k) {
     BladePose a, b;
@@ -239,9 +245,19 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
     if (k + 1 == 100 || (k + 1) % 1000 == 0 || k + 1 == strokes) report(k + 1);
   }
   EXPECT_GT(cuts, strokes * 3 / 10);
-  // Not asserted (README, known limitations): after some strokes CG stops converging (16 of
-  // 100 here, the residual diverging although the free block is SPD) - the CG preconditioner
-  // is factored with pieces that hang on by a node; the solver owner's to fix.
+  // Issue 9 item 4: every solve after a stroke converges, in at most twice the uncut mesh's
+  // iterations (measured: 1, as uncut, over 300 strokes; the factor of the cut matrix solves it
+  // directly).
+  EXPECT_EQ(not_converged, 0);
+  EXPECT_LE(*std::max_element(iterations.begin(), iterations.end()),
+            2 * std::max(cold_iterations, 1));
+  // Shapes (not met: >= 5 deg asked; the input itself starts at 1.9 deg): regression guards
+  // with margin over what stop 38 measures after 100 strokes (241 tets under 5 deg, min 0.42
+  // deg; 261 / 0.55 with stop 37's smoothing).
+  if (strokes >= 100) {
+    EXPECT_LE(thin_at_100, 300) << "tets under 5 deg after 100 strokes";
+    EXPECT_GT(dihedral_at_100, 0.2) << "min dihedral after 100 strokes";
+  }
 }
 
 // The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k
