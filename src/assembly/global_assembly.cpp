@@ -143,7 +143,7 @@ void add_difference(SparseMatrix& a, const SparseMatrix& d,
   const int base = first < n_old ? a.outerIndexPtr()[first] : static_cast<int>(a.nonZeros());
   const int tail_old = static_cast<int>(a.nonZeros()) - base;
   spare.resize(1, 1);  // its arrays only: inner indices and values of the tail
-  spare.data().resize(tail_old + d.nonZeros(), 0.125);
+  spare.resizeNonZeros(tail_old + d.nonZeros());
   int* inner = spare.innerIndexPtr();
   double* value = spare.valuePtr();
   std::vector<int> outer(static_cast<size_t>(n - first) + 1);
@@ -180,9 +180,7 @@ void add_difference(SparseMatrix& a, const SparseMatrix& d,
   }
   outer[static_cast<size_t>(n - first)] = k;
   a.conservativeResize(n, n);  // new rows empty; the compressed prefix kept
-  // Keeps the first `base` entries; room for the next cuts' entries, so that a cut adding a
-  // few does not reallocate (and copy) the whole matrix, dense interface block included.
-  a.data().resize(base + k, 0.125);
+  a.resizeNonZeros(base + k);  // keeps the first `base` entries
   std::copy(inner, inner + k, a.innerIndexPtr() + base);
   std::copy(value, value + k, a.valuePtr() + base);
   for (int r = first; r <= n; ++r)
