@@ -90,55 +90,51 @@ TEST(CutSmoothing, AnInteriorNodeMovesOutOfTheSliversAroundIt) {
   EXPECT_TRUE(state.stroke_tets.empty());  // the stroke's tets are forgotten
 }
 
+// v, pushed off where its star is best, may slide (how_node_may_move says `kind`, its axis along
+// coordinate `axis_dim`): the smoothing raises its star's smallest angle by more than 5 deg and
+// keeps the volume and the boundary's area exact.
+void expect_slides(TetMesh& mesh, CutState& state, int v, NodeMove kind, int axis_dim,
+                   const char* label) {
+  const double volume = total_volume(mesh);
+  const double area = surface_area(mesh);
+  Vec3 axis;
+  ASSERT_EQ(how_node_may_move(mesh, state, v, axis), kind) << label;
+  EXPECT_FALSE(may_move_inside_star(mesh, state, v)) << label;
+  EXPECT_NEAR(std::abs(axis[axis_dim]), 1.0, 1e-12) << label;
+  const double before = star_min_dihedral(mesh, state, v);
+  smooth_star(mesh, state, v);
+  const double after = star_min_dihedral(mesh, state, v);
+  std::printf("%s: star's smallest dihedral %.2f -> %.2f deg\n", label, before, after);
+  EXPECT_GT(after, before + 5.0) << label;
+  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume) << label;
+  EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area) << label;
+}
+
 TEST(CutSmoothing, ANodeOnAFlatFaceSlidesWithinIt) {
   TetMesh mesh = box();
   CutState state = make_cut_state(mesh, {}, {});
-  const double volume = total_volume(mesh);
-  const double area = surface_area(mesh);
   // A node of the z = 0 face, pushed within the face towards a neighbour.
   const int v = node_at(mesh, Vec3(0.03, 0.03, 0.0));
   mesh.nodes[v] += Vec3(0.009, 0, 0);
   ASSERT_EQ(mesh.nodes[v].z(), 0.0);
-  Vec3 normal;
-  ASSERT_EQ(how_node_may_move(mesh, state, v, normal), NodeMove::kInPlane);
-  EXPECT_FALSE(may_move_inside_star(mesh, state, v));
-  EXPECT_NEAR(std::abs(normal.z()), 1.0, 1e-12);
-  const double before = star_min_dihedral(mesh, state, v);
-  smooth_star(mesh, state, v);
-  const double after = star_min_dihedral(mesh, state, v);
-  std::printf("face node: star's smallest dihedral %.2f -> %.2f deg\n", before, after);
-  EXPECT_GT(after, before + 5.0);
+  expect_slides(mesh, state, v, NodeMove::kInPlane, 2, "face node");
   EXPECT_EQ(mesh.nodes[v].z(), 0.0);  // still in its face
-  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
-  EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area);
 }
 
 TEST(CutSmoothing, ANodeOnAnEdgeSlidesAlongIt) {
   TetMesh mesh = box();
   CutState state = make_cut_state(mesh, {}, {});
-  const double volume = total_volume(mesh);
-  const double area = surface_area(mesh);
   // A node of the box's edge y = z = 0 (its fan: two flat fans at 90 deg), pushed along it.
   const int v = node_at(mesh, Vec3(0.03, 0.0, 0.0));
   mesh.nodes[v].x() += 0.009;
-  Vec3 axis;
-  ASSERT_EQ(how_node_may_move(mesh, state, v, axis), NodeMove::kOnLine);
-  EXPECT_NEAR(std::abs(axis.x()), 1.0, 1e-12);
-  const double before = star_min_dihedral(mesh, state, v);
-  smooth_star(mesh, state, v);
-  const double after = star_min_dihedral(mesh, state, v);
-  std::printf("edge node: star's smallest dihedral %.2f -> %.2f deg\n", before, after);
-  EXPECT_GT(after, before + 5.0);
+  expect_slides(mesh, state, v, NodeMove::kOnLine, 0, "edge node");
   EXPECT_EQ(mesh.nodes[v].y(), 0.0);  // still on its edge
   EXPECT_EQ(mesh.nodes[v].z(), 0.0);
-  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
-  EXPECT_NEAR(surface_area(mesh), area, 1e-12 * area);
 }
 
 TEST(CutSmoothing, ANodeOnACutThatHasNotOpenedSlidesWithinIt) {
   TetMesh mesh = box();
   CutState state = make_cut_state(mesh, {}, {});
-  const double volume = total_volume(mesh);
   // An interior node with the faces around it in the plane z = 0.03 marked as a cut that has
   // not opened (both tets' bits, as a held-closed mark leaves them), pushed within the plane.
   const int v = node_at(mesh, Vec3(0.03, 0.03, 0.03));
@@ -159,16 +155,8 @@ TEST(CutSmoothing, ANodeOnACutThatHasNotOpenedSlidesWithinIt) {
     }
   ASSERT_GE(marked, 4);  // a fan around v
   mesh.nodes[v] += Vec3(0.009, 0, 0);
-  Vec3 axis;
-  ASSERT_EQ(how_node_may_move(mesh, state, v, axis), NodeMove::kInPlane);
-  EXPECT_NEAR(std::abs(axis.z()), 1.0, 1e-12);
-  const double before = star_min_dihedral(mesh, state, v);
-  smooth_star(mesh, state, v);
-  const double after = star_min_dihedral(mesh, state, v);
-  std::printf("node on a closed cut: star's smallest dihedral %.2f -> %.2f deg\n", before, after);
-  EXPECT_GT(after, before + 5.0);
+  expect_slides(mesh, state, v, NodeMove::kInPlane, 2, "node on a closed cut");
   EXPECT_EQ(mesh.nodes[v].z(), z);  // the marked faces stay in their plane
-  EXPECT_NEAR(total_volume(mesh), volume, 1e-12 * volume);
 }
 
 TEST(CutSmoothing, LockedAndCornerNodesStay) {
