@@ -43,6 +43,7 @@ NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Ve
   // where a cut meets another cut or a flat stretch of the tissue's surface); the open faces
   // of one plane all face one way.
   std::vector<Vec3> planes;
+  std::vector<Vec3> area;   // per plane: its faces' area vectors, summed along planes[p]
   std::vector<int> facing;  // per plane: +1 / -1 the open faces' side, 0 none yet
   for (const auto* faces : {&fan, &closed})
     for (const auto& face : *faces) {
@@ -52,13 +53,19 @@ NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Ve
         const Vec3 n = normal_of(face);
         if (!(n.norm() > 0) || planes.size() == 2) return NodeMove::kNone;
         planes.push_back(n.normalized());
+        area.push_back(Vec3::Zero());
         facing.push_back(0);
       }
+      const Vec3 n = normal_of(face);
+      const int side = n.dot(planes[p]) > 0 ? 1 : -1;
+      area[p] += side * n;
       if (faces == &closed) continue;
-      const int side = normal_of(face).dot(planes[p]) > 0 ? 1 : -1;
       if (facing[p] != 0 && facing[p] != side) return NodeMove::kNone;
       facing[p] = side;
     }
+  // Each plane's normal from all its faces (the first face alone may be a sliver's, its
+  // normal off by more than round-off).
+  for (size_t p = 0; p < planes.size(); ++p) planes[p] = area[p].normalized();
   NodeMove kind = NodeMove::kInPlane;
   axis = planes[0];
   if (planes.size() == 2) {

@@ -369,8 +369,8 @@ TEST(CutProperty, QualityAfter100Cuts) {
   // sweeps cut, 67-77 of 100), box seed 99 smoothed min 0.39 deg. The smoothing's gain is
   // within the seeds' scatter on one specimen, so it is asserted over all twelve runs.
   // Stop 38 (nodes on a crease slide along it, nodes on a cut that has not opened slide within
-  // its plane: node_moves.hpp): with smoothing thigh 641 -> 497, box 645 -> 428, liver 467 ->
-  // 317; against none, 2061 -> 1242 (-40 %, was -15 %; smoothed minima 0.50-1.80 deg).
+  // its plane: node_moves.hpp): with smoothing thigh 641 -> 497, box 645 -> 421, liver 467 ->
+  // 317; against none, 2061 -> 1235 (-40 %, was -15 %; smoothed minima 0.50-1.80 deg).
   // Asserted: at least a quarter fewer.
   std::array<int, 2> thin = {0, 0};
   for (const auto& [specimen, min_ratio] :
