@@ -73,7 +73,7 @@ int worst_tet(const TetMesh& mesh, const CutState& state, int v, const Vec3& x) 
 // how_node_may_move's).
 Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double guard, NodeMove how,
                    const Vec3& axis, double& quality) {
-  const auto in_plane = [how, &axis](const Vec3& d) -> Vec3 {
+  const auto allowed = [how, &axis](const Vec3& d) -> Vec3 {
     if (how == NodeMove::kInPlane) return d - axis * axis.dot(d);
     if (how == NodeMove::kOnLine) return axis * axis.dot(d);
     return d;
@@ -98,13 +98,13 @@ Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double gua
   };
   // The centroid of the star's other corners (Laplacian smoothing) as a first guess.
   if (neighbours > 0) {
-    const Vec3 c = start + in_plane(centroid / neighbours - start);
+    const Vec3 c = start + allowed(centroid / neighbours - start);
     const double qc = star_smallest_dihedral(mesh, state, v, c, guard);
     if (better(c, qc)) x = c, q = qc;
   }
   double step = 0.1 * shortest;
   const double eps = 1e-4 * shortest, smallest_step = 1e-2 * shortest;
-  // The ascent direction at x: the worst tet's gradient within the plane (zero: none). A
+  // The ascent direction at x: the worst tet's gradient within the plane or line (zero: none). A
   // gradient (nearly) normal to the plane is none: what the projection leaves of it is
   // round-off, and normalising that would step off the plane.
   const auto direction = [&](const Vec3& at) -> Vec3 {
@@ -118,13 +118,13 @@ Vec3 best_position(const TetMesh& mesh, const CutState& state, int v, double gua
                      tet_smallest_dihedral(mesh, worst, v, down)) /
                     (2 * eps);
     }
-    const Vec3 along = in_plane(gradient);
+    const Vec3 along = allowed(gradient);
     return along.norm() > 1e-6 * gradient.norm() ? Vec3(along.normalized()) : Vec3::Zero();
   };
   Vec3 along = direction(x);
   for (int iteration = 0; iteration < 30 && step > smallest_step && along != Vec3::Zero();
        ++iteration) {
-    const Vec3 y = x + in_plane(step * along);
+    const Vec3 y = x + allowed(step * along);
     const double qy = star_smallest_dihedral(mesh, state, v, y, guard);
     if (better(y, qy)) {
       x = y, q = qy;

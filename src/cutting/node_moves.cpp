@@ -47,16 +47,15 @@ NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Ve
   std::vector<int> facing;  // per plane: +1 / -1 the open faces' side, 0 none yet
   for (const auto* faces : {&fan, &closed})
     for (const auto& face : *faces) {
+      const Vec3 n = normal_of(face);
       size_t p = 0;
       while (p < planes.size() && !lies_in(face, planes[p])) ++p;
       if (p == planes.size()) {
-        const Vec3 n = normal_of(face);
         if (!(n.norm() > 0) || planes.size() == 2) return NodeMove::kNone;
         planes.push_back(n.normalized());
         area.push_back(Vec3::Zero());
         facing.push_back(0);
       }
-      const Vec3 n = normal_of(face);
       const int side = n.dot(planes[p]) > 0 ? 1 : -1;
       area[p] += side * n;
       if (faces == &closed) continue;

@@ -75,33 +75,17 @@ std::vector<int> TetGrid::query(const TetMesh& mesh, const Vec3& lo, const Vec3&
     stamp_ = 1;
   }
   std::vector<int> found;
-  const auto a = cell_of(lo), b = cell_of(hi);
-  for (int k = a[2]; k <= b[2]; ++k)
-    for (int j = a[1]; j <= b[1]; ++j)
-      for (int i = a[0]; i <= b[0]; ++i)
-        for (int t : cells_[(static_cast<size_t>(k) * dims_[1] + j) * dims_[0] + i]) {
-          if (seen_[t] == stamp_) continue;
-          seen_[t] = stamp_;
-          Vec3 tlo, thi;
-          tet_bounds(mesh, t, tlo, thi);
-          if ((tlo.array() <= hi.array()).all() && (thi.array() >= lo.array()).all())
-            found.push_back(t);
-        }
+  first_overlapping(mesh, lo, hi, [&](int t) {
+    if (seen_[t] != stamp_) found.push_back(t);  // a tet listed in several cells: once
+    seen_[t] = stamp_;
+    return false;
+  });
   std::sort(found.begin(), found.end());
   return found;
 }
 
 bool TetGrid::any(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const {
-  const auto a = cell_of(lo), b = cell_of(hi);
-  for (int k = a[2]; k <= b[2]; ++k)
-    for (int j = a[1]; j <= b[1]; ++j)
-      for (int i = a[0]; i <= b[0]; ++i)
-        for (int t : cells_[(static_cast<size_t>(k) * dims_[1] + j) * dims_[0] + i]) {
-          Vec3 tlo, thi;
-          tet_bounds(mesh, t, tlo, thi);
-          if ((tlo.array() <= hi.array()).all() && (thi.array() >= lo.array()).all()) return true;
-        }
-  return false;
+  return first_overlapping(mesh, lo, hi, [](int) { return true; });
 }
 
 }  // namespace stc

@@ -12,6 +12,9 @@
 
 namespace stc {
 
+// Rest-position bounding box of a tet.
+void tet_bounds(const TetMesh& mesh, int tet, Vec3& lo, Vec3& hi);
+
 class TetGrid {
  public:
   // Grid over the tets with include[t] != 0 (all tets when include is empty).
@@ -25,6 +28,22 @@ class TetGrid {
 
  private:
   std::array<int, 3> cell_of(const Vec3& p) const;
+  // Calls stop(t) for every listed tet (once per cell it is listed in) whose box overlaps
+  // [lo, hi], until it returns true; returns whether it did.
+  template <class Stop>
+  bool first_overlapping(const TetMesh& mesh, const Vec3& lo, const Vec3& hi, Stop stop) const {
+    const auto a = cell_of(lo), b = cell_of(hi);
+    for (int k = a[2]; k <= b[2]; ++k)
+      for (int j = a[1]; j <= b[1]; ++j)
+        for (int i = a[0]; i <= b[0]; ++i)
+          for (int t : cells_[(static_cast<size_t>(k) * dims_[1] + j) * dims_[0] + i]) {
+            Vec3 tlo, thi;
+            tet_bounds(mesh, t, tlo, thi);
+            if ((tlo.array() <= hi.array()).all() && (thi.array() >= lo.array()).all() && stop(t))
+              return true;
+          }
+    return false;
+  }
   Vec3 origin_ = Vec3::Zero();
   double cell_size_ = 1.0;
   std::array<int, 3> dims_ = {1, 1, 1};
@@ -32,8 +51,5 @@ class TetGrid {
   mutable std::vector<unsigned> seen_;  // per tet: query stamp, to report each tet once
   mutable unsigned stamp_ = 0;
 };
-
-// Rest-position bounding box of a tet.
-void tet_bounds(const TetMesh& mesh, int tet, Vec3& lo, Vec3& hi);
 
 }  // namespace stc
