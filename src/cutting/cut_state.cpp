@@ -44,4 +44,35 @@ std::vector<int> tets_with_edge(const CutState& state, int a, int b) {
   return shared;
 }
 
+std::vector<std::array<int, 4>> star_neighbours(const TetMesh& mesh, const CutState& state,
+                                                int v) {
+  const std::vector<int>& star = state.node_tets[v];
+  std::vector<std::array<int, 4>> across(star.size(), {-1, -1, -1, -1});
+  // A face through v is named by its two other corners; its two tets list the same pair.
+  std::vector<std::pair<std::uint64_t, int>> faces;  // (pair, 4 k + f)
+  faces.reserve(3 * star.size());
+  for (size_t k = 0; k < star.size(); ++k) {
+    const Tet& t = mesh.tets[star[k]];
+    for (int f = 0; f < 4; ++f) {
+      if (t[f] == v) continue;  // the face opposite v
+      std::array<std::uint32_t, 2> other;
+      int n = 0;
+      for (int c = 0; c < 3; ++c)
+        if (const int w = t[kTetFaces[f][c]]; w != v) other[n++] = static_cast<std::uint32_t>(w);
+      if (other[0] > other[1]) std::swap(other[0], other[1]);
+      faces.emplace_back((static_cast<std::uint64_t>(other[0]) << 32) | other[1],
+                         static_cast<int>(4 * k) + f);
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  for (size_t i = 0; i + 1 < faces.size(); ++i)
+    if (faces[i].first == faces[i + 1].first) {
+      const int a = faces[i].second, b = faces[i + 1].second;
+      across[a / 4][a % 4] = b / 4;
+      across[b / 4][b % 4] = a / 4;
+      ++i;
+    }
+  return across;
+}
+
 }  // namespace stc

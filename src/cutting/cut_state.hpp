@@ -99,4 +99,11 @@ inline void set_moved_to_border(CutState& state, int v) {
 // The tets that use both a and b, ascending.
 std::vector<int> tets_with_edge(const CutState& state, int a, int b);
 
+// v's star (state.node_tets[v]) with its faces through v matched: entry [k][f] is the position
+// in the star of the tet across local face f of star tet k, or -1 where that face is on the
+// boundary or does not touch v (f opposite v). A tet across a face through v uses v, so it is in
+// the star: one sort of the star's faces answers what a neighbour_across per face (a scan of a
+// corner's tets) would.
+std::vector<std::array<int, 4>> star_neighbours(const TetMesh& mesh, const CutState& state, int v);
+
 }  // namespace stc

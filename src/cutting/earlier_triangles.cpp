@@ -73,12 +73,7 @@ struct CandidateFaces {
 
 std::vector<int> tets_around_cut(const TetMesh& mesh, const CutState& state, Vec3& lo, Vec3& hi) {
   const Vec3 cut_lo = lo, cut_hi = hi;
-  for (int t : state.grid.query(mesh, cut_lo, cut_hi)) {
-    Vec3 a, b;
-    tet_bounds(mesh, t, a, b);
-    lo = lo.cwiseMin(a);
-    hi = hi.cwiseMax(b);
-  }
+  state.grid.grow_by_overlapping(mesh, cut_lo, cut_hi, lo, hi);
   return cuttable_tets_in(mesh, state, lo, hi);
 }
 

@@ -14,12 +14,14 @@ NodeMove how_node_may_move(const TetMesh& mesh, const CutState& state, int v, Ve
   // out of the tet: those with no neighbour (the fan) and the cuts that have not opened.
   std::vector<std::array<int, 2>> fan, closed;
   double scale = 0;
-  for (int t : state.node_tets[v]) {
+  const std::vector<std::array<int, 4>> across = star_neighbours(mesh, state, v);
+  for (size_t s = 0; s < across.size(); ++s) {
+    const int t = state.node_tets[v][s];
     if (!state.cuttable[t]) return NodeMove::kNone;
     const Tet& k = mesh.tets[t];
     for (int f = 0; f < 4; ++f) {
       if (k[f] == v) continue;  // the face opposite v does not touch it
-      const bool open = neighbour_across(mesh, state, t, f).first < 0;
+      const bool open = across[s][f] < 0;
       if (!open && !mesh.is_cut_face(t, f)) continue;
       std::array<int, 3> face = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
       while (face[0] != v) std::rotate(face.begin(), face.begin() + 1, face.end());

@@ -12,6 +12,7 @@ namespace {
 // A node's star split into pieces connected through shared unmarked faces.
 std::vector<std::vector<int>> star_components(const TetMesh& mesh, const CutState& state, int v) {
   const std::vector<int>& star = state.node_tets[v];
+  const std::vector<std::array<int, 4>> across = star_neighbours(mesh, state, v);
   std::vector<int> component(star.size(), -1);
   std::vector<std::vector<int>> pieces;
   for (size_t seed = 0; seed < star.size(); ++seed) {
@@ -27,12 +28,10 @@ std::vector<std::vector<int>> star_components(const TetMesh& mesh, const CutStat
       pieces[id].push_back(t);
       for (int f = 0; f < 4; ++f) {
         if (mesh.tets[t][f] == v || mesh.is_cut_face(t, f)) continue;  // faces through v only
-        const int other = neighbour_across(mesh, state, t, f).first;
-        if (other < 0) continue;
-        const size_t j = std::find(star.begin(), star.end(), other) - star.begin();
-        if (j < star.size() && component[j] < 0) {
-          component[j] = id;
-          stack.push_back(j);
+        const int j = across[k][f];
+        if (j >= 0 && component[static_cast<size_t>(j)] < 0) {
+          component[static_cast<size_t>(j)] = id;
+          stack.push_back(static_cast<size_t>(j));
         }
       }
     }

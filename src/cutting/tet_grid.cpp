@@ -75,7 +75,7 @@ std::vector<int> TetGrid::query(const TetMesh& mesh, const Vec3& lo, const Vec3&
     stamp_ = 1;
   }
   std::vector<int> found;
-  first_overlapping(mesh, lo, hi, [&](int t) {
+  first_overlapping(mesh, lo, hi, [&](int t, const Vec3&, const Vec3&) {
     if (seen_[t] != stamp_) found.push_back(t);  // a tet listed in several cells: once
     seen_[t] = stamp_;
     return false;
@@ -85,7 +85,16 @@ std::vector<int> TetGrid::query(const TetMesh& mesh, const Vec3& lo, const Vec3&
 }
 
 bool TetGrid::any(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const {
-  return first_overlapping(mesh, lo, hi, [](int) { return true; });
+  return first_overlapping(mesh, lo, hi, [](int, const Vec3&, const Vec3&) { return true; });
+}
+
+void TetGrid::grow_by_overlapping(const TetMesh& mesh, const Vec3& lo, const Vec3& hi, Vec3& ulo,
+                                  Vec3& uhi) const {
+  first_overlapping(mesh, lo, hi, [&](int, const Vec3& a, const Vec3& b) {
+    ulo = ulo.cwiseMin(a);
+    uhi = uhi.cwiseMax(b);
+    return false;
+  });
 }
 
 }  // namespace stc

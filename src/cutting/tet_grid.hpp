@@ -25,11 +25,15 @@ class TetGrid {
   // Whether query() would list any tet: stops at the first (no list, no sort). The moving
   // region asks this for every sample of a sweep at every cutting step.
   bool any(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const;
+  // The union of the boxes of the listed tets that overlap [lo, hi], grown from [ulo, uhi]
+  // (no list, no sort: a tet listed in several cells is merged again, which changes nothing).
+  void grow_by_overlapping(const TetMesh& mesh, const Vec3& lo, const Vec3& hi, Vec3& ulo,
+                           Vec3& uhi) const;
 
  private:
   std::array<int, 3> cell_of(const Vec3& p) const;
-  // Calls stop(t) for every listed tet (once per cell it is listed in) whose box overlaps
-  // [lo, hi], until it returns true; returns whether it did.
+  // Calls stop(t, box_lo, box_hi) for every listed tet (once per cell it is listed in) whose
+  // box overlaps [lo, hi], until it returns true; returns whether it did.
   template <class Stop>
   bool first_overlapping(const TetMesh& mesh, const Vec3& lo, const Vec3& hi, Stop stop) const {
     const auto a = cell_of(lo), b = cell_of(hi);
@@ -39,7 +43,8 @@ class TetGrid {
           for (int t : cells_[(static_cast<size_t>(k) * dims_[1] + j) * dims_[0] + i]) {
             Vec3 tlo, thi;
             tet_bounds(mesh, t, tlo, thi);
-            if ((tlo.array() <= hi.array()).all() && (thi.array() >= lo.array()).all() && stop(t))
+            if ((tlo.array() <= hi.array()).all() && (thi.array() >= lo.array()).all() &&
+                stop(t, tlo, thi))
               return true;
           }
     return false;

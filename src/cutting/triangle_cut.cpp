@@ -34,9 +34,10 @@ bool flat_within(const std::vector<std::array<Vec3, 3>>& surface, const Vec3& no
 
 // Is node v on the mesh's boundary (a face of one of its tets with no neighbour)?
 bool on_boundary(const TetMesh& mesh, const CutState& state, int v) {
-  for (int t : state.node_tets[v])
+  const std::vector<std::array<int, 4>> across = star_neighbours(mesh, state, v);
+  for (size_t k = 0; k < across.size(); ++k)
     for (int f = 0; f < 4; ++f)
-      if (mesh.tets[t][f] != v && neighbour_across(mesh, state, t, f).first < 0) return true;
+      if (mesh.tets[state.node_tets[v][k]][f] != v && across[k][f] < 0) return true;
   return false;
 }
 

@@ -1,6 +1,6 @@
 // The tet grid (cutting/tet_grid.hpp) against a scan of every tet: query() lists exactly the
 // included tets whose rest box overlaps the query box, ascending; any() answers whether it
-// lists one. On the thigh and a TetGen liver, with boxes from a point to a few tets across,
+// lists one; grow_by_overlapping() gives the union of their boxes. On the thigh and a TetGen liver, with boxes from a point to a few tets across,
 // in and around the tissue, and a grid over part of the tets.
 #include "common/cut_fidelity_scenes.hpp"
 #include "cutting/tet_grid.hpp"
@@ -39,6 +39,15 @@ void expect_grid_matches_scan(const TetMesh& mesh, const char* name) {
     const std::vector<int> found = grid.query(mesh, a, b);
     ASSERT_EQ(found, scan) << name << ": query " << q;
     ASSERT_EQ(grid.any(mesh, a, b), !scan.empty()) << name << ": query " << q;
+    Vec3 union_lo = a, union_hi = b, grown_lo = a, grown_hi = b;
+    for (int t : scan) {
+      Vec3 t_lo, t_hi;
+      tet_bounds(mesh, t, t_lo, t_hi);
+      union_lo = union_lo.cwiseMin(t_lo), union_hi = union_hi.cwiseMax(t_hi);
+    }
+    grid.grow_by_overlapping(mesh, a, b, grown_lo, grown_hi);
+    ASSERT_EQ(grown_lo, union_lo) << name << ": query " << q;
+    ASSERT_EQ(grown_hi, union_hi) << name << ": query " << q;
     ++(scan.empty() ? misses : hits);
   }
   // Both answers were exercised.

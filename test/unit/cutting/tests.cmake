@@ -6,6 +6,7 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_cut_fidelity_gravity.cpp
   test/unit/cutting/test_cut_property.cpp
   test/unit/cutting/test_cut_smoothing.cpp
+  test/unit/cutting/test_cut_state.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
   test/unit/cutting/test_earlier_triangles.cpp
   test/unit/cutting/test_tet_grid.cpp
