@@ -1,6 +1,6 @@
 #include "cutting/node_moves.hpp"
 
-#include "cutting/triangle_cut.hpp"
+#include "cutting/cut_state.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
