@@ -1,6 +1,7 @@
 #include "cutting/cut_smoothing.hpp"
 
 #include "cutting/node_moves.hpp"
+#include "cutting/tet_flips.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
@@ -188,6 +189,13 @@ void smooth_last_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   std::sort(tets.begin(), tets.end());
   tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
   smooth_tets(mesh, state, options, tets, result);
+  // What smoothing could not raise (corners that may not move: on the curved skin, on several
+  // cut planes, locked), flips may (docs/DESIGN.md section 8, "Flip"): the stroke's tets and
+  // those the smoothing changed, as they are now.
+  if (options.flip_thin_tets) {
+    tets.insert(tets.end(), result.changed_tets.begin(), result.changed_tets.end());
+    result.flips += flip_thin_tets(mesh, state, options, tets, result).total();
+  }
 }
 
 }  // namespace stc

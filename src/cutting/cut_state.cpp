@@ -44,8 +44,7 @@ std::vector<int> tets_with_edge(const CutState& state, int a, int b) {
   return shared;
 }
 
-std::vector<std::array<int, 4>> star_neighbours(const TetMesh& mesh, const CutState& state,
-                                                int v) {
+std::vector<std::array<int, 4>> star_neighbours(const TetMesh& mesh, const CutState& state, int v) {
   const std::vector<int>& star = state.node_tets[v];
   std::vector<std::array<int, 4>> across(star.size(), {-1, -1, -1, -1});
   // A face through v is named by its two other corners; its two tets list the same pair.

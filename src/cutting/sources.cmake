@@ -11,6 +11,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/cutting/node_moves.cpp
   src/cutting/rest_mapping.cpp
   src/cutting/separation.cpp
+  src/cutting/tet_flips.cpp
   src/cutting/tet_grid.cpp
   src/cutting/triangle_cut.cpp
 )

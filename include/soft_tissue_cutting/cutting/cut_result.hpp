@@ -40,6 +40,10 @@ struct CutOptions {
   // dihedral angle below this (degrees) are moved to raise it where no surface moves: inside
   // their stars, or within a flat cut wall (cutting/cut_smoothing.hpp). 0: off.
   double smooth_below_deg = 10.0;
+  // After the smoothing, the tets still below smooth_below_deg are flipped where a 2-3 flip or
+  // an edge removal (4-4 to 7-10) over interior faces on no cut raises the smallest angle
+  // (cutting/tet_flips.hpp): no node and no surface moves. false: smoothing only.
+  bool flip_thin_tets = true;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
   // docs/SCENE.md "Cut invariants": "small fraction" is this number. With snap 0.1 a tet can be cut
@@ -77,6 +81,9 @@ struct CutResult {
   // Of moved_nodes, how many the last stroke's smoothing moved (a new stroke's first cut does
   // it first; cutting/cut_smoothing.hpp): a change of shape, not a cut.
   int nodes_smoothed = 0;
+  // Flips the last stroke's tets took at the same time (cutting/tet_flips.hpp): connectivity,
+  // not a cut.
+  int flips = 0;
   // Did the cut split, add or mark anything? (Moving nodes alone - the smoothing, or a node
   // relocated onto a cut that opened nothing there - changes the mesh's shape, not its cut:
   // the same stroke again relocates what the last one's smoothing moved off it.)

@@ -1,7 +1,8 @@
 // The tet grid (cutting/tet_grid.hpp) against a scan of every tet: query() lists exactly the
 // included tets whose rest box overlaps the query box, ascending; any() answers whether it
-// lists one; grow_by_overlapping() gives the union of their boxes. On the thigh and a TetGen liver, with boxes from a point to a few tets across,
-// in and around the tissue, and a grid over part of the tets.
+// lists one; grow_by_overlapping() gives the union of their boxes. On the thigh and a TetGen liver,
+// with boxes from a point to a few tets across, in and around the tissue, and a grid over part of
+// the tets.
 #include "common/cut_fidelity_scenes.hpp"
 #include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"

@@ -9,5 +9,6 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_cut_state.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
   test/unit/cutting/test_earlier_triangles.cpp
+  test/unit/cutting/test_tet_flips.cpp
   test/unit/cutting/test_tet_grid.cpp
 )

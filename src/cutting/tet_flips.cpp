@@ -1,0 +1,410 @@
+#include "cutting/tet_flips.hpp"
+
+#include "cutting/triangle_cut.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace stc {
+namespace {
+
+// A flip must gain more than this over the tets it replaces (as the smoothing's move must):
+// well above round-off, so no flip is decided by a position's last digits.
+constexpr double kFlipGainDeg = 0.05;
+// Edge removal up to this many tets around the edge (a ring of 7: 42 triangulations, 10 tets).
+constexpr int kMaxRing = 7;
+
+double smallest_angle(const TetMesh& mesh, const Tet& k) {
+  return smallest_dihedral_deg(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
+                               mesh.nodes[k[3]]);
+}
+
+double volume_of(const TetMesh& mesh, const Tet& k) {
+  return signed_volume(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]], mesh.nodes[k[3]]);
+}
+
+// 6 sqrt(2) V / l_max^3 (1 for the regular tet): a flip must not trade it away for the angle
+// (a ring's long chord), as the smoothing's move must not (cut_smoothing.cpp).
+double volume_ratio(const TetMesh& mesh, const Tet& k) {
+  double longest = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      longest = std::max(longest, (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
+  return 6 * std::sqrt(2.0) * volume_of(mesh, k) / (longest * longest * longest);
+}
+
+double smallest_volume_ratio(const TetMesh& mesh, const std::vector<Tet>& tets) {
+  double smallest = 1e300;
+  for (const Tet& k : tets) smallest = std::min(smallest, volume_ratio(mesh, k));
+  return smallest;
+}
+
+// A replacement of the tets `cavity` by `tets` (positively oriented) over the same region.
+struct Flip {
+  bool face = false;  // a 2-3 flip (else an edge removal)
+  std::vector<int> cavity;
+  std::vector<Tet> tets;
+  std::vector<std::array<int, 2>> new_edges;  // edges the cavity did not have
+  double before = 0;                          // smallest dihedral angle of the cavity's tets
+  double after = -1;                          // of the new ones
+};
+
+// The cavity's smallest angle and size class; false if a tet of it is not cuttable.
+bool describe_cavity(const TetMesh& mesh, const CutState& state, Flip& flip, double& size_class) {
+  flip.before = 180;
+  size_class = 1e300;
+  for (int t : flip.cavity) {
+    if (!state.cuttable[static_cast<size_t>(t)]) return false;
+    flip.before = std::min(flip.before, smallest_angle(mesh, mesh.tets[static_cast<size_t>(t)]));
+    size_class = std::min(size_class, state.origin_volume[static_cast<size_t>(t)]);
+  }
+  return true;
+}
+
+// Every new tet positive and above the size guard, the same total volume (to round-off: the
+// new tets then tile the cavity, their boundary being its boundary with its orientation).
+bool tiles_cavity(const TetMesh& mesh, const Flip& flip, double min_volume) {
+  double before = 0, after = 0;
+  for (int t : flip.cavity) before += tet_volume(mesh, t);
+  for (const Tet& k : flip.tets) {
+    const double v = volume_of(mesh, k);
+    if (!(v > min_volume)) return false;
+    after += v;
+  }
+  return std::abs(after - before) <= 1e-12 * before;
+}
+
+// The 2-3 flip of face f of tet t: the tets (p, q, r, d) and (r, q, p, e) on either side of
+// face pqr become (p, q, e, d), (q, r, e, d), (r, p, e, d) around edge de, which must cross pqr.
+bool face_flip(const TetMesh& mesh, const CutState& state, int t, int f, double guard, Flip& flip) {
+  if (mesh.is_cut_face(t, f)) return false;
+  const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+  if (other < 0) return false;
+  const Tet& k = mesh.tets[static_cast<size_t>(t)];
+  const int d = k[static_cast<size_t>(f)],
+            e = mesh.tets[static_cast<size_t>(other)][static_cast<size_t>(other_face)];
+  int p = k[kTetFaces[f][0]], q = k[kTetFaces[f][1]], r = k[kTetFaces[f][2]];
+  if (!(signed_volume(mesh.nodes[p], mesh.nodes[q], mesh.nodes[r], mesh.nodes[d]) > 0))
+    std::swap(q, r);
+  flip.cavity = {t, other};
+  double size_class = 0;
+  if (!describe_cavity(mesh, state, flip, size_class)) return false;
+  flip.face = true;
+  flip.tets = {Tet{p, q, e, d}, Tet{q, r, e, d}, Tet{r, p, e, d}};
+  flip.new_edges = {{d, e}};
+  if (!tiles_cavity(mesh, flip, guard * size_class)) return false;
+  flip.after = 180;
+  for (const Tet& n : flip.tets) flip.after = std::min(flip.after, smallest_angle(mesh, n));
+  return true;
+}
+
+// Edge removal of (a, b): its ring p_0 .. p_m-1 (signed_volume(a, b, p_i, p_i+1) > 0) and the
+// triangulation of the ring polygon whose tets (a, p_i, p_j, p_k), (b, p_k, p_j, p_i) (i < j < k)
+// have the largest smallest angle, by dynamic programming over the polygon's sub-chains.
+bool edge_removal(const TetMesh& mesh, const CutState& state, int a, int b, double guard,
+                  Flip& flip) {
+  const std::vector<int> ring_tets = tets_with_edge(state, a, b);
+  const int m = static_cast<int>(ring_tets.size());
+  if (m < 4 || m > kMaxRing) return false;
+  // Each ring tet's two other corners; the faces through the edge must be on no cut.
+  std::vector<std::array<int, 2>> pairs;
+  for (int t : ring_tets) {
+    const Tet& k = mesh.tets[static_cast<size_t>(t)];
+    std::array<int, 2> other{};
+    int n = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (k[static_cast<size_t>(i)] == a || k[static_cast<size_t>(i)] == b) continue;
+      other[static_cast<size_t>(n++)] = k[static_cast<size_t>(i)];
+      if (mesh.is_cut_face(t, i)) return false;  // the face opposite this corner has the edge
+    }
+    pairs.push_back(other);
+  }
+  // Chain the pairs into one closed ring (an edge on the boundary leaves it open).
+  std::vector<int> ring = {pairs[0][0], pairs[0][1]};
+  std::vector<char> used(static_cast<size_t>(m), 0);
+  used[0] = 1;
+  for (int step = 1; step < m; ++step) {
+    bool found = false;
+    for (int i = 0; i < m && !found; ++i) {
+      if (used[static_cast<size_t>(i)]) continue;
+      for (int s = 0; s < 2; ++s)
+        if (pairs[static_cast<size_t>(i)][static_cast<size_t>(s)] == ring.back()) {
+          used[static_cast<size_t>(i)] = 1;
+          if (step < m - 1)
+            ring.push_back(pairs[static_cast<size_t>(i)][static_cast<size_t>(1 - s)]);
+          else if (pairs[static_cast<size_t>(i)][static_cast<size_t>(1 - s)] != ring.front())
+            return false;
+          found = true;
+          break;
+        }
+    }
+    if (!found) return false;
+  }
+  if (static_cast<int>(ring.size()) != m) return false;
+  const Vec3 &xa = mesh.nodes[static_cast<size_t>(a)], &xb = mesh.nodes[static_cast<size_t>(b)];
+  if (!(signed_volume(xa, xb, mesh.nodes[static_cast<size_t>(ring[0])],
+                      mesh.nodes[static_cast<size_t>(ring[1])]) > 0))
+    std::reverse(ring.begin(), ring.end());
+  flip.face = false;
+  flip.cavity = ring_tets;
+  double size_class = 0;
+  if (!describe_cavity(mesh, state, flip, size_class)) return false;
+  const double min_volume = guard * size_class;
+  // q[i][j][k]: the smallest angle of triangle (i, j, k)'s two tets, -1 if one is not positive.
+  double q[kMaxRing][kMaxRing][kMaxRing];
+  for (int i = 0; i < m; ++i)
+    for (int j = i + 1; j < m; ++j)
+      for (int k = j + 1; k < m; ++k) {
+        const Tet ta{a, ring[static_cast<size_t>(i)], ring[static_cast<size_t>(j)],
+                     ring[static_cast<size_t>(k)]};
+        const Tet tb{b, ring[static_cast<size_t>(k)], ring[static_cast<size_t>(j)],
+                     ring[static_cast<size_t>(i)]};
+        q[i][j][k] = volume_of(mesh, ta) > min_volume && volume_of(mesh, tb) > min_volume
+                         ? std::min(smallest_angle(mesh, ta), smallest_angle(mesh, tb))
+                         : -1;
+      }
+  // best[i][j]: the best smallest angle over triangulations of the chain i..j (j - i >= 2),
+  // apex[i][j] the k that achieves it.
+  double best[kMaxRing][kMaxRing];
+  int apex[kMaxRing][kMaxRing];
+  for (int span = 2; span < m; ++span)
+    for (int i = 0; i + span < m; ++i) {
+      const int j = i + span;
+      best[i][j] = -1;
+      apex[i][j] = -1;
+      for (int k = i + 1; k < j; ++k) {
+        double v = q[i][k][j];
+        if (k - i >= 2) v = std::min(v, best[i][k]);
+        if (j - k >= 2) v = std::min(v, best[k][j]);
+        if (v > best[i][j]) best[i][j] = v, apex[i][j] = k;
+      }
+    }
+  if (!(best[0][m - 1] > 0)) return false;
+  flip.tets.clear();
+  flip.new_edges.clear();
+  std::vector<std::array<int, 2>> chains = {{0, m - 1}};
+  while (!chains.empty()) {
+    const auto [i, j] = chains.back();
+    chains.pop_back();
+    if (j - i < m - 1)  // a chord of the ring (0 - (m - 1) is its closing side)
+      flip.new_edges.push_back({ring[static_cast<size_t>(i)], ring[static_cast<size_t>(j)]});
+    const int k = apex[i][j];
+    flip.tets.push_back(Tet{a, ring[static_cast<size_t>(i)], ring[static_cast<size_t>(k)],
+                            ring[static_cast<size_t>(j)]});
+    flip.tets.push_back(Tet{b, ring[static_cast<size_t>(j)], ring[static_cast<size_t>(k)],
+                            ring[static_cast<size_t>(i)]});
+    if (k - i >= 2) chains.push_back({i, k});
+    if (j - k >= 2) chains.push_back({k, j});
+  }
+  if (!tiles_cavity(mesh, flip, min_volume)) return false;
+  flip.after = best[0][m - 1];
+  return true;
+}
+
+// The last stroke's triangles (CutState::last_sweep, margins included). The same path cut once
+// more (a repeated `~cut`, which must then find nothing left to cut:
+// `RepeatedCutSaysItIsAlreadyCut` cut 5 passes in a row with unrestricted flips) splits an edge
+// that crosses them, snaps one that nearly does, and marks a closed face on them whose two tets'
+// opposite corners come to lie on either side. So no flip makes an edge that comes within the snap
+// distance (0.1 of its length, CutOptions::snap_tolerance) of a triangle's plane over the triangle
+// (reached_by), or replaces a tet behind a closed face lying on the triangles (holds: its corners
+// within the snap distance of a plane, over the triangle or a quarter of it beyond, where the
+// borders are split).
+class SweptSurface {
+ public:
+  explicit SweptSurface(const std::vector<std::array<Vec3, 3>>& triangles) {
+    for (const auto& t : triangles) {
+      const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+      const double diameter =
+          std::max({(t[1] - t[0]).norm(), (t[2] - t[1]).norm(), (t[0] - t[2]).norm()});
+      if (!(n.norm() > 1e-12 * diameter * diameter)) continue;  // a plunge sweeps nothing
+      const Vec3 pad = Vec3::Constant(kOverSlack * diameter);
+      triangles_.push_back({t, n.normalized(), n.norm(), t[0].cwiseMin(t[1]).cwiseMin(t[2]) - pad,
+                            t[0].cwiseMax(t[1]).cwiseMax(t[2]) + pad});
+    }
+  }
+
+  // Do all of a face's corners lie within `near` of one triangle's plane, over it?
+  bool holds(const Vec3& a, const Vec3& b, const Vec3& c, double near) const {
+    for (const Triangle& t : triangles_) {
+      bool all = true;
+      for (const Vec3* x : {&a, &b, &c}) {
+        if ((x->array() < t.lo.array() - near).any() || (x->array() > t.hi.array() + near).any() ||
+            std::abs(t.normal.dot(*x - t.corner[0])) > near || !over(t, *x, kOverSlack)) {
+          all = false;
+          break;
+        }
+      }
+      if (all) return true;
+    }
+    return false;
+  }
+
+  bool reached_by(const Vec3& p, const Vec3& q, double snap) const {
+    const double near = snap * (q - p).norm();
+    const Vec3 lo = p.cwiseMin(q) - Vec3::Constant(near), hi = p.cwiseMax(q) + Vec3::Constant(near);
+    for (const Triangle& t : triangles_) {
+      if ((lo.array() > t.hi.array()).any() || (hi.array() < t.lo.array()).any()) continue;
+      const double dp = t.normal.dot(p - t.corner[0]), dq = t.normal.dot(q - t.corner[0]);
+      if ((dp > near && dq > near) || (dp < -near && dq < -near)) continue;  // clear of it
+      // Where the segment comes nearest the plane (it crosses there, or an end), over it?
+      const double s = dp * dq < 0 ? dp / (dp - dq) : (std::abs(dp) < std::abs(dq) ? 0.0 : 1.0);
+      if (over(t, p + s * (q - p), 1e-6)) return true;
+    }
+    return false;
+  }
+
+ private:
+  // Barycentric slack of "over a triangle": the cut's borders are split a quarter of an element
+  // beyond the sweep (cut_sweep.cpp), so its neighbourhood counts too.
+  static constexpr double kOverSlack = 0.25;
+  struct Triangle {
+    std::array<Vec3, 3> corner;
+    Vec3 normal;
+    double double_area;
+    Vec3 lo, hi;
+  };
+  std::vector<Triangle> triangles_;
+
+  static bool over(const Triangle& t, const Vec3& x, double slack) {
+    const double u = t.normal.dot((t.corner[1] - x).cross(t.corner[2] - x)) / t.double_area;
+    const double v = t.normal.dot((t.corner[2] - x).cross(t.corner[0] - x)) / t.double_area;
+    return u >= -slack && v >= -slack && 1 - u - v >= -slack;
+  }
+};
+
+// Replaces the cavity's tets: its indices first (ascending), then appended ones; the cut marks
+// of its boundary faces go to the new tets that have those faces (the faces inside were on no
+// cut). Returns the new tets' indices.
+std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
+  std::set<FaceKey> marked;
+  double size_class = 1e300;
+  for (int t : flip.cavity) {
+    const Tet& k = mesh.tets[static_cast<size_t>(t)];
+    for (int f = 0; f < 4; ++f)
+      if (mesh.is_cut_face(t, f)) {
+        FaceKey key = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
+        std::sort(key.begin(), key.end());
+        marked.insert(key);
+      }
+    size_class = std::min(size_class, state.origin_volume[static_cast<size_t>(t)]);
+    for (int v : k) {
+      auto& star = state.node_tets[static_cast<size_t>(v)];
+      star.erase(std::find(star.begin(), star.end(), t));
+    }
+  }
+  std::vector<int> indices = flip.cavity;
+  std::sort(indices.begin(), indices.end());
+  for (size_t n = 0; n < flip.tets.size(); ++n) {
+    int t = 0;
+    if (n < indices.size()) {
+      t = indices[n];
+      mesh.tets[static_cast<size_t>(t)] = flip.tets[n];
+    } else {
+      t = mesh.num_tets();
+      indices.push_back(t);
+      mesh.tets.push_back(flip.tets[n]);
+      mesh.cut_faces.push_back(0);
+      state.cuttable.push_back(1);
+      state.origin_volume.push_back(size_class);
+    }
+    std::uint8_t bits = 0;
+    const Tet& k = flip.tets[n];
+    for (int f = 0; f < 4; ++f) {
+      FaceKey key = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
+      std::sort(key.begin(), key.end());
+      if (marked.count(key)) bits |= static_cast<std::uint8_t>(1u << f);
+    }
+    mesh.cut_faces[static_cast<size_t>(t)] = bits;
+    for (int i = 0; i < 4; ++i)  // a new edge may be longer than any before (the bound holds)
+      for (int j = i + 1; j < 4; ++j)
+        state.longest_edge_bound = std::max(
+            state.longest_edge_bound, (mesh.nodes[static_cast<size_t>(k[static_cast<size_t>(i)])] -
+                                       mesh.nodes[static_cast<size_t>(k[static_cast<size_t>(j)])])
+                                          .norm());
+    state.origin_volume[static_cast<size_t>(t)] = size_class;
+    for (int v : k) state.node_tets[static_cast<size_t>(v)].push_back(t);
+    state.grid.insert(mesh, t);  // a kept index's new box may lie in other cells
+  }
+  return indices;
+}
+
+// The best flip that removes tet t (through its faces or around its edges), if any gains.
+bool best_flip(const TetMesh& mesh, const CutState& state, int t, double guard,
+               const SweptSurface& swept, double snap, Flip& best) {
+  bool found = false;
+  const auto disturbs_last_stroke = [&](const Flip& candidate) {
+    for (const auto& [p, q] : candidate.new_edges)
+      if (swept.reached_by(mesh.nodes[static_cast<size_t>(p)], mesh.nodes[static_cast<size_t>(q)],
+                           snap))
+        return true;
+    // A closed face of the cavity's boundary on the stroke's surface (SweptSurface).
+    for (int c : candidate.cavity)
+      for (int f = 0; f < 4; ++f) {
+        if (mesh.is_cut_face(c, f)) continue;
+        const Tet& k = mesh.tets[static_cast<size_t>(c)];
+        const Vec3 &a = mesh.nodes[static_cast<size_t>(k[kTetFaces[f][0]])],
+                   &b = mesh.nodes[static_cast<size_t>(k[kTetFaces[f][1]])],
+                   &d = mesh.nodes[static_cast<size_t>(k[kTetFaces[f][2]])];
+        const double longest = std::max({(a - b).norm(), (b - d).norm(), (d - a).norm()});
+        if (swept.holds(a, b, d, snap * longest)) return true;
+      }
+    return false;
+  };
+  const auto ratio_kept = [&](const Flip& candidate) {
+    std::vector<Tet> old;
+    for (int c : candidate.cavity) old.push_back(mesh.tets[static_cast<size_t>(c)]);
+    return smallest_volume_ratio(mesh, candidate.tets) >= smallest_volume_ratio(mesh, old);
+  };
+  const auto consider = [&](Flip& candidate) {
+    if (candidate.after > candidate.before + kFlipGainDeg && ratio_kept(candidate) &&
+        (!found || candidate.after > best.after) && !disturbs_last_stroke(candidate)) {
+      best = candidate;
+      found = true;
+    }
+  };
+  Flip candidate;
+  for (int f = 0; f < 4; ++f)
+    if (face_flip(mesh, state, t, f, guard, candidate)) consider(candidate);
+  const Tet& k = mesh.tets[static_cast<size_t>(t)];
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+      if (edge_removal(mesh, state, k[static_cast<size_t>(i)], k[static_cast<size_t>(j)], guard,
+                       candidate))
+        consider(candidate);
+  return found;
+}
+
+}  // namespace
+
+FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
+                          const std::vector<int>& tets, CutResult& result) {
+  FlipCounts flips;
+  if (!(options.smooth_below_deg > 0)) return flips;
+  const double guard = 2 * options.min_volume_fraction;
+  const SweptSurface swept(state.last_sweep);
+  std::vector<int> queue = tets;
+  // Two rounds: the second over the tets the first made (a flip's new tets may flip again).
+  for (int round = 0; round < 2 && !queue.empty(); ++round) {
+    std::sort(queue.begin(), queue.end());
+    queue.erase(std::unique(queue.begin(), queue.end()), queue.end());
+    std::vector<int> made;
+    for (int t : queue) {
+      if (t >= mesh.num_tets() ||
+          smallest_angle(mesh, mesh.tets[static_cast<size_t>(t)]) >= options.smooth_below_deg)
+        continue;
+      Flip flip;
+      if (!best_flip(mesh, state, t, guard, swept, options.snap_tolerance, flip)) continue;
+      const std::vector<int> changed = apply(mesh, state, flip);
+      result.changed_tets.insert(result.changed_tets.end(), changed.begin(), changed.end());
+      made.insert(made.end(), changed.begin(), changed.end());
+      ++(flip.face ? flips.faces : flips.edges);
+    }
+    queue = std::move(made);
+  }
+  return flips;
+}
+
+}  // namespace stc

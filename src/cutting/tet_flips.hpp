@@ -1,0 +1,36 @@
+// Connectivity after a stroke (docs/DESIGN.md section 8, "Flip"): the smoothing moves nodes,
+// but most corners of the thin tets a stroke leaves cannot move (on the curved skin, on several
+// cut planes, locked). Their tets can still be replaced by better ones over the same cavity:
+//
+// - a 2-3 flip: two tets sharing a face become three around the edge joining their apexes,
+// - an edge removal: the m tets around an edge become the 2 (m - 2) tets that pair the best
+//   triangulation of their ring polygon with the edge's two ends (4 <= m <= 7: 4-4 to 7-10).
+//
+// Only across interior faces that are on no cut and around interior edges none of whose faces
+// is, in cuttable tets: the boundary, every cut face and the volume stay as they were (no node
+// moves), so what opened stays open and nothing closed opens. The flipped tets keep their
+// indices and the rest are appended, as a bisection's children are (the 3-2 flip, which removes
+// a tet, is not among them); the new tets' size class is the smallest of the cavity's.
+#pragma once
+
+#include "cutting/cut_state.hpp"
+#include "soft_tissue_cutting/cutting/cut_result.hpp"
+
+#include <vector>
+
+namespace stc {
+
+struct FlipCounts {
+  int faces = 0;  // 2-3 flips
+  int edges = 0;  // edge removals
+  int total() const { return faces + edges; }
+};
+
+// Flips that raise the smallest dihedral angle of `tets` below CutOptions::smooth_below_deg
+// (and of the tets the flips make), each by more than 0.05 deg over the tets it replaces and
+// keeping every new tet above twice CutOptions::min_volume_fraction of its size class. The
+// changed and appended tets go to result.changed_tets.
+FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
+                          const std::vector<int>& tets, CutResult& result);
+
+}  // namespace stc
