@@ -385,9 +385,9 @@ TEST(CutProperty, QualityAfter100Cuts) {
   std::printf("all specimens: tets under 5 deg %d -> %d smoothed -> %d smoothed and flipped\n",
               thin[0], thin[1], thin[2]);
   EXPECT_LE(thin[1], 0.75 * thin[0]) << "the smoothing removes at least a quarter of the thin tets";
-  // Stop 39 (flips, cutting/tet_flips.hpp): 1235 -> 1087 (-12 %; thigh 497 -> 434, box 421 ->
-  // 354, liver 317 -> 299). Asserted over the twelve runs: at least 5 % fewer.
-  EXPECT_LE(thin[2], 0.95 * thin[1]) << "the flips remove at least 5 % of what the smoothing left";
+  // Stop 39 (flips, cutting/tet_flips.hpp): 1235 -> 939 (-24 %; thigh 497 -> 381, box 421 ->
+  // 291, liver 317 -> 267). Asserted over the twelve runs: at least 15 % fewer.
+  EXPECT_LE(thin[2], 0.85 * thin[1]) << "the flips remove at least 15 % of what the smoothing left";
 }
 
 }  // namespace
