@@ -37,20 +37,15 @@ double star_volume(const TetMesh& mesh, const CutState& state, int v, const Vec3
   return volume;
 }
 
-// The smallest volume ratio of v's star with v at x: 6 sqrt(2) volume / (longest edge)^3, 1 for
-// a regular tet (mesh/quality.hpp's measure).
+// The smallest volume ratio (mesh/quality.hpp) of v's star with v at x.
 double star_smallest_volume_ratio(const TetMesh& mesh, const CutState& state, int v,
                                   const Vec3& x) {
   double smallest = 1e300;
   for (int t : state.node_tets[v]) {
     const Tet& k = mesh.tets[t];
     const Vec3* p[4];
-    double longest = 0;
     for (int i = 0; i < 4; ++i) p[i] = k[i] == v ? &x : &mesh.nodes[k[i]];
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (*p[i] - *p[j]).norm());
-    smallest = std::min(smallest, 6 * std::sqrt(2.0) * signed_volume(*p[0], *p[1], *p[2], *p[3]) /
-                                      (longest * longest * longest));
+    smallest = std::min(smallest, volume_ratio(*p[0], *p[1], *p[2], *p[3]));
   }
   return smallest;
 }

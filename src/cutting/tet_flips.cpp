@@ -25,19 +25,13 @@ double volume_of(const TetMesh& mesh, const Tet& k) {
   return signed_volume(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]], mesh.nodes[k[3]]);
 }
 
-// 6 sqrt(2) V / l_max^3 (1 for the regular tet): a flip must not trade it away for the angle
-// (a ring's long chord), as the smoothing's move must not (cut_smoothing.cpp).
-double volume_ratio(const TetMesh& mesh, const Tet& k) {
-  double longest = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j)
-      longest = std::max(longest, (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
-  return 6 * std::sqrt(2.0) * volume_of(mesh, k) / (longest * longest * longest);
-}
-
+// The smallest volume ratio (mesh/quality.hpp) of `tets`: a flip must not trade it away for
+// the angle (a ring's long chord), as the smoothing's move must not (cut_smoothing.cpp).
 double smallest_volume_ratio(const TetMesh& mesh, const std::vector<Tet>& tets) {
   double smallest = 1e300;
-  for (const Tet& k : tets) smallest = std::min(smallest, volume_ratio(mesh, k));
+  for (const Tet& k : tets)
+    smallest = std::min(smallest, volume_ratio(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]],
+                                               mesh.nodes[k[3]]));
   return smallest;
 }
 
@@ -46,18 +40,19 @@ struct Flip {
   bool face = false;  // a 2-3 flip (else an edge removal)
   std::vector<int> cavity;
   std::vector<Tet> tets;
-  double before = 0;  // smallest dihedral angle of the cavity's tets
-  double after = -1;  // of the new ones
+  double size_class = 0;  // the smallest of the cavity's: the new tets'
+  double before = 0;      // smallest dihedral angle of the cavity's tets
+  double after = -1;      // of the new ones
 };
 
 // The cavity's smallest angle and size class; false if a tet of it is not cuttable.
-bool describe_cavity(const TetMesh& mesh, const CutState& state, Flip& flip, double& size_class) {
+bool describe_cavity(const TetMesh& mesh, const CutState& state, Flip& flip) {
   flip.before = 180;
-  size_class = 1e300;
+  flip.size_class = 1e300;
   for (int t : flip.cavity) {
     if (!state.cuttable[static_cast<size_t>(t)]) return false;
     flip.before = std::min(flip.before, smallest_angle(mesh, mesh.tets[static_cast<size_t>(t)]));
-    size_class = std::min(size_class, state.origin_volume[static_cast<size_t>(t)]);
+    flip.size_class = std::min(flip.size_class, state.origin_volume[static_cast<size_t>(t)]);
   }
   return true;
 }
@@ -88,11 +83,10 @@ bool face_flip(const TetMesh& mesh, const CutState& state, int t, int f, double 
   if (!(signed_volume(mesh.nodes[p], mesh.nodes[q], mesh.nodes[r], mesh.nodes[d]) > 0))
     std::swap(q, r);
   flip.cavity = {t, other};
-  double size_class = 0;
-  if (!describe_cavity(mesh, state, flip, size_class)) return false;
+  if (!describe_cavity(mesh, state, flip)) return false;
   flip.face = true;
   flip.tets = {Tet{p, q, e, d}, Tet{q, r, e, d}, Tet{r, p, e, d}};
-  if (!tiles_cavity(mesh, flip, guard * size_class)) return false;
+  if (!tiles_cavity(mesh, flip, guard * flip.size_class)) return false;
   flip.after = 180;
   for (const Tet& n : flip.tets) flip.after = std::min(flip.after, smallest_angle(mesh, n));
   return true;
@@ -147,9 +141,8 @@ bool edge_removal(const TetMesh& mesh, const CutState& state, int a, int b, doub
     std::reverse(ring.begin(), ring.end());
   flip.face = false;
   flip.cavity = ring_tets;
-  double size_class = 0;
-  if (!describe_cavity(mesh, state, flip, size_class)) return false;
-  const double min_volume = guard * size_class;
+  if (!describe_cavity(mesh, state, flip)) return false;
+  const double min_volume = guard * flip.size_class;
   // q[i][j][k]: the smallest angle of triangle (i, j, k)'s two tets, -1 if one is not positive.
   double q[kMaxRing][kMaxRing][kMaxRing];
   for (int i = 0; i < m; ++i)
@@ -262,7 +255,6 @@ class SweptSurface {
 // cut). Returns the new tets' indices.
 std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
   std::set<FaceKey> marked;
-  double size_class = 1e300;
   for (int t : flip.cavity) {
     const Tet& k = mesh.tets[static_cast<size_t>(t)];
     for (int f = 0; f < 4; ++f)
@@ -271,7 +263,6 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
         std::sort(key.begin(), key.end());
         marked.insert(key);
       }
-    size_class = std::min(size_class, state.origin_volume[static_cast<size_t>(t)]);
     for (int v : k) {
       auto& star = state.node_tets[static_cast<size_t>(v)];
       star.erase(std::find(star.begin(), star.end(), t));
@@ -290,7 +281,7 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
       mesh.tets.push_back(flip.tets[n]);
       mesh.cut_faces.push_back(0);
       state.cuttable.push_back(1);
-      state.origin_volume.push_back(size_class);
+      state.origin_volume.push_back(flip.size_class);
     }
     std::uint8_t bits = 0;
     const Tet& k = flip.tets[n];
@@ -306,7 +297,7 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
             state.longest_edge_bound, (mesh.nodes[static_cast<size_t>(k[static_cast<size_t>(i)])] -
                                        mesh.nodes[static_cast<size_t>(k[static_cast<size_t>(j)])])
                                           .norm());
-    state.origin_volume[static_cast<size_t>(t)] = size_class;
+    state.origin_volume[static_cast<size_t>(t)] = flip.size_class;
     for (int v : k) state.node_tets[static_cast<size_t>(v)].push_back(t);
     state.grid.insert(mesh, t);  // a kept index's new box may lie in other cells
   }

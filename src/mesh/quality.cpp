@@ -49,6 +49,17 @@ double smallest_dihedral_deg(const Vec3& a, const Vec3& b, const Vec3& c, const 
   return angle_deg(least);
 }
 
+double volume_ratio(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3* p[4] = {&a, &b, &c, &d};
+  double longest = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (*p[i] - *p[j]).norm());
+  // A regular tet with edge L has volume L^3 / (6 sqrt 2).
+  return longest > 0
+             ? 6 * std::sqrt(2.0) * signed_volume(a, b, c, d) / (longest * longest * longest)
+             : 0;
+}
+
 MeshQuality mesh_quality(const TetMesh& mesh) {
   MeshQuality q;
   q.min_dihedral_deg = q.min_volume = q.min_volume_ratio = std::numeric_limits<double>::max();
@@ -64,13 +75,7 @@ MeshQuality mesh_quality(const TetMesh& mesh) {
     const double v = signed_volume(a, b, c, d);
     q.min_volume = std::min(q.min_volume, v);
     q.max_volume = std::max(q.max_volume, v);
-    const Vec3 p[4] = {a, b, c, d};
-    double longest = 0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (p[i] - p[j]).norm());
-    // A regular tet with edge L has volume L^3 / (6 sqrt 2).
-    const double ratio = longest > 0 ? v * 6.0 * std::sqrt(2.0) / (longest * longest * longest) : 0;
-    q.min_volume_ratio = std::min(q.min_volume_ratio, ratio);
+    q.min_volume_ratio = std::min(q.min_volume_ratio, volume_ratio(a, b, c, d));
   }
   if (mesh.tets.empty()) q = MeshQuality{};
   return q;
