@@ -33,6 +33,7 @@ int bisect_edge(TetMesh& mesh, CutState& state, int a, int b, double t, std::vec
     star_b.erase(std::find(star_b.begin(), star_b.end(), tet));
     for (int v : added) state.node_tets[v].push_back(child);
     state.node_tets[m].push_back(tet);
+    state.grid.refresh(mesh, tet);  // the kept child's box lies in the parent's
     state.grid.insert(mesh, child);
     changed.push_back(tet);
     changed.push_back(child);

@@ -15,6 +15,7 @@ void tet_bounds(const TetMesh& mesh, int tet, Vec3& lo, Vec3& hi) {
 
 void TetGrid::build(const TetMesh& mesh, const std::vector<std::uint8_t>& include) {
   cells_.clear();
+  boxes_.assign(mesh.tets.size(), Box{Vec3::Zero(), Vec3::Zero()});
   seen_.assign(mesh.tets.size(), 0);
   stamp_ = 0;
   Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
@@ -58,10 +59,19 @@ std::array<int, 3> TetGrid::cell_of(const Vec3& p) const {
   return c;
 }
 
+void TetGrid::keep_box(const TetMesh& mesh, int tet) {
+  if (boxes_.size() < mesh.tets.size())
+    boxes_.resize(mesh.tets.size(), Box{Vec3::Zero(), Vec3::Zero()});
+  Box& box = boxes_[static_cast<size_t>(tet)];
+  tet_bounds(mesh, tet, box.lo, box.hi);
+}
+
+void TetGrid::refresh(const TetMesh& mesh, int tet) { keep_box(mesh, tet); }
+
 void TetGrid::insert(const TetMesh& mesh, int tet) {
-  Vec3 lo, hi;
-  tet_bounds(mesh, tet, lo, hi);
-  const auto a = cell_of(lo), b = cell_of(hi);
+  keep_box(mesh, tet);
+  const Box& box = boxes_[static_cast<size_t>(tet)];
+  const auto a = cell_of(box.lo), b = cell_of(box.hi);
   for (int k = a[2]; k <= b[2]; ++k)
     for (int j = a[1]; j <= b[1]; ++j)
       for (int i = a[0]; i <= b[0]; ++i)

@@ -2,8 +2,11 @@
 // included tets whose rest box overlaps the query box, ascending; any() answers whether it
 // lists one; grow_by_overlapping() gives the union of their boxes. On the thigh and a TetGen liver,
 // with boxes from a point to a few tets across, in and around the tissue, and a grid over part of
-// the tets.
+// the tets; and the grid a cut state keeps, after strokes that bisect tets, move nodes and flip
+// (the grid keeps each tet's box: every change of a tet's corners must reach it).
 #include "common/cut_fidelity_scenes.hpp"
+#include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
 #include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
@@ -14,13 +17,10 @@
 namespace stc {
 namespace {
 
-void expect_grid_matches_scan(const TetMesh& mesh, const char* name) {
+void expect_grid_matches_scan(const TetMesh& mesh, const TetGrid& grid,
+                              const std::vector<std::uint8_t>& include, const char* name) {
   Vec3 lo = mesh.nodes[0], hi = mesh.nodes[0];
   for (const Vec3& p : mesh.nodes) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  std::vector<std::uint8_t> include(mesh.tets.size());
-  for (size_t t = 0; t < include.size(); ++t) include[t] = t % 3 != 0;  // part of the tets
-  TetGrid grid;
-  grid.build(mesh, include);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(-0.1, 1.1);  // around the tissue too
   std::uniform_real_distribution<double> size(0.0, 0.05);  // a point to ~5 % of the extent
@@ -56,12 +56,53 @@ void expect_grid_matches_scan(const TetMesh& mesh, const char* name) {
   EXPECT_GT(misses, 20) << name;
 }
 
+void expect_grid_matches_scan(const TetMesh& mesh, const char* name) {
+  std::vector<std::uint8_t> include(mesh.tets.size());
+  for (size_t t = 0; t < include.size(); ++t) include[t] = t % 3 != 0;  // part of the tets
+  TetGrid grid;
+  grid.build(mesh, include);
+  expect_grid_matches_scan(mesh, grid, include, name);
+}
+
 TEST(TetGrid, QueryAndAnyMatchAScanOnTheThigh) {
   expect_grid_matches_scan(make_thigh_scene().mesh, "thigh");
 }
 
 TEST(TetGrid, QueryAndAnyMatchAScanOnATetGenLiver) {
   expect_grid_matches_scan(fidelity::tetgen_liver("liver2", 5000), "TetGen liver");
+}
+
+// Strokes change tets three ways: bisection (a kept child inside its parent's box, appended
+// children), node moves (snapping, the smoothing) and flips (new tets on kept indices). The
+// grid's kept boxes must follow all of them: its answers equal a scan of the live boxes.
+TEST(TetGrid, TheCutStatesGridFollowsStrokes) {
+  TetMesh mesh = fidelity::tetgen_liver("liver2", 5000);
+  CutState state = make_cut_state(mesh, {}, {});
+  const int tets_before = mesh.num_tets();
+  const Vec3 top = fidelity::top_node(mesh);
+  CutResult total;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 tip = top + Vec3(-0.03 + 0.011 * k, -0.012 - 0.002 * k, -0.02 + 0.007 * k);
+    const Vec3 along = Vec3(1, 0.15 * (k % 3), 0.5 - 0.2 * k).normalized();
+    BladeEdge from{tip, tip + 0.04 * Vec3(0.3 - 0.1 * k, 1, 0.2 * k).normalized(), Vec3::UnitZ()};
+    for (int step = 0; step < 8; ++step) {
+      BladeEdge to = from;
+      to.tip += 0.003 * along;
+      to.heel += 0.003 * along;
+      const CutResult r = cut_sweep(mesh, state, from, to);
+      total.moved_nodes.insert(total.moved_nodes.end(), r.moved_nodes.begin(), r.moved_nodes.end());
+      total.flips += r.flips;
+      total.tets_split += r.tets_split;
+      from = to;
+    }
+    finish_stroke(mesh, state);
+  }
+  // All three kinds of change happened.
+  EXPECT_GT(total.tets_split, 100);
+  EXPECT_FALSE(total.moved_nodes.empty());
+  EXPECT_GT(total.flips, 0);
+  ASSERT_GT(mesh.num_tets(), tets_before);
+  expect_grid_matches_scan(mesh, state.grid, state.cuttable, "TetGen liver after 4 strokes");
 }
 
 }  // namespace
