@@ -165,6 +165,15 @@ bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
   return false;
 }
 
+bool StrokeSurface::corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
+                                double skin_slack) {
+  if (near_node(mesh, v, slack)) return true;
+  if (!near_node(mesh, v, skin_slack * slack)) return false;
+  std::int8_t& boundary = known_[v].on_boundary;
+  if (boundary < 0) boundary = on_boundary(mesh, state, v) ? 1 : 0;
+  return boundary != 0;
+}
+
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi) {
   std::vector<int> tets;
@@ -553,10 +562,7 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
   // breaks through the skin, and the blade's edge carried to rest coordinates outside the
   // tissue is extrapolated (rest_mapping.hpp), so the stroke's surface only approximates
   // where the blade crossed the skin.
-  auto corner_ok = [&](int v) {
-    return surface.near_node(mesh, v, slack) ||
-           (on_boundary(mesh, state, v) && surface.near_node(mesh, v, skin_slack * slack));
-  };
+  auto corner_ok = [&](int v) { return surface.corner_near(mesh, state, v, slack, skin_slack); };
   if (!corner_ok(p) || !corner_ok(q) || !corner_ok(r)) return;
   if (!state.cuttable[other]) {  // the blade stops at the condensed part
     result.reached_interface = true;

@@ -170,5 +170,35 @@ TEST(EarlierTriangles, MarkWhatEachTriangleAloneMarksOnATetGenLiver) {
   expect_same_marks(mesh, {}, t, end - Vec3(0.02, 0, 0.01), end + Vec3(0, 0.04, 0.02), 30, false);
 }
 
+// A face's corner test (StrokeSurface::corner_near): within the slack of the stroke's surface,
+// or on the tissue's boundary within skin_slack x the slack - what it finds out once per node
+// must not change the answer for another slack. Every node of the cube (its boundary is where
+// a coordinate is 0 or 4 cm) against a plane 0.1 mm above its middle layer, slacks asked in
+// an order that grows and shrinks, twice.
+TEST(EarlierTriangles, CornerTestIsNearOrOnTheSkinAndNearerAtEveryAskedSlack) {
+  TetMesh mesh = cube();
+  const CutState state = make_cut_state(mesh, {}, {});
+  const double z = 0.0201;
+  StrokeSurface surface({{Vec3(-0.01, -0.01, z), Vec3(0.05, -0.01, z), Vec3(0.05, 0.05, z)},
+                         {Vec3(-0.01, -0.01, z), Vec3(0.05, 0.05, z), Vec3(-0.01, 0.05, z)}});
+  int skin_only = 0, near = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (double slack : {2e-4, 3e-5, 1e-4, 5e-5, 1e-3, 2e-5}) {
+      for (int v = 0; v < mesh.num_nodes(); ++v) {
+        const Vec3& x = mesh.nodes[v];
+        const bool skin = (x.array() < 1e-9).any() || (x.array() > 0.04 - 1e-9).any();
+        const double d = std::abs(x.z() - z);
+        const bool expected = d <= slack || (skin && d <= kSkinCornerSlack * slack);
+        ASSERT_EQ(surface.corner_near(mesh, state, v, slack, kSkinCornerSlack), expected)
+            << "node " << v << " at " << x.transpose() << ", slack " << slack;
+        skin_only += expected && d > slack;
+        near += expected;
+      }
+    }
+  // Both reasons occurred (the middle layer's skin nodes at 3e-5 and 5e-5).
+  EXPECT_GT(skin_only, 0);
+  EXPECT_GT(near, skin_only);
+}
+
 }  // namespace
 }  // namespace stc
