@@ -6,6 +6,7 @@
 
 #include "common/cut_fidelity.hpp"
 #include "cutting/cut_state.hpp"
+#include "cutting/cut_sweep.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
 #include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/io/mesh_reader.hpp"
@@ -153,6 +154,33 @@ inline Scene sagging_liver() {
   s.scalpel = ScalpelParams{0.02, 0.5};
   s.solver = SolverParams{Backend::kCpu, 1e-10, 4000};
   return s;
+}
+
+// `strokes` 2.4 cm strokes in 3 mm sweeps across the top of a liver from
+// tetgen_liver, each along another direction and tilt, each ended (finish_stroke): cuts that
+// bisect tets, move nodes onto the cut and, from the second stroke on, smooth and flip the
+// last one's tets. Returns the results' totals (moved nodes listed, counts summed).
+inline CutResult crossing_strokes(TetMesh& mesh, CutState& state, int strokes,
+                                  const CutOptions& options = {}) {
+  CutResult total;
+  const Vec3 top = top_node(mesh);
+  for (int k = 0; k < strokes; ++k) {
+    const Vec3 tip = top + Vec3(-0.03 + 0.011 * k, -0.012 - 0.002 * k, -0.02 + 0.007 * k);
+    const Vec3 along = Vec3(1, 0.15 * (k % 3), 0.5 - 0.2 * k).normalized();
+    BladeEdge from{tip, tip + 0.04 * Vec3(0.3 - 0.1 * k, 1, 0.2 * k).normalized(), Vec3::UnitZ()};
+    for (int step = 0; step < 8; ++step) {
+      BladeEdge to = from;
+      to.tip += 0.003 * along;
+      to.heel += 0.003 * along;
+      const CutResult r = cut_sweep(mesh, state, from, to, options);
+      total.moved_nodes.insert(total.moved_nodes.end(), r.moved_nodes.begin(), r.moved_nodes.end());
+      total.flips += r.flips;
+      total.tets_split += r.tets_split;
+      from = to;
+    }
+    finish_stroke(mesh, state, options);
+  }
+  return total;
 }
 
 }  // namespace stc::fidelity

@@ -102,20 +102,7 @@ TEST(TetFlips, AfterStrokesOnATetGenLiverOnlyTheInsideChanges) {
   const double volume = total_volume(mesh);
   CutOptions options;
   options.flip_thin_tets = false;  // the strokes smooth but do not flip
-  const Vec3 top = fidelity::top_node(mesh);
-  for (int k = 0; k < 6; ++k) {
-    const Vec3 tip = top + Vec3(-0.03 + 0.011 * k, -0.012 - 0.002 * k, -0.02 + 0.007 * k);
-    const Vec3 along = Vec3(1, 0.15 * (k % 3), 0.5 - 0.2 * k).normalized();
-    BladeEdge from{tip, tip + 0.04 * Vec3(0.3 - 0.1 * k, 1, 0.2 * k).normalized(), Vec3::UnitZ()};
-    for (int step = 0; step < 8; ++step) {
-      BladeEdge to = from;
-      to.tip += 0.003 * along;
-      to.heel += 0.003 * along;
-      cut_sweep(mesh, state, from, to, options);
-      from = to;
-    }
-    finish_stroke(mesh, state, options);
-  }
+  fidelity::crossing_strokes(mesh, state, 6, options);
   const auto stay = faces_that_stay(mesh);
   const int thin_before = thin_tets(mesh), tets_before = mesh.num_tets();
   std::vector<int> all(static_cast<size_t>(mesh.num_tets()));

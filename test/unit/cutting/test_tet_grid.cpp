@@ -6,7 +6,6 @@
 // (the grid keeps each tet's box: every change of a tet's corners must reach it).
 #include "common/cut_fidelity_scenes.hpp"
 #include "cutting/cut_state.hpp"
-#include "cutting/cut_sweep.hpp"
 #include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/generators/thigh.hpp"
 
@@ -79,24 +78,7 @@ TEST(TetGrid, TheCutStatesGridFollowsStrokes) {
   TetMesh mesh = fidelity::tetgen_liver("liver2", 5000);
   CutState state = make_cut_state(mesh, {}, {});
   const int tets_before = mesh.num_tets();
-  const Vec3 top = fidelity::top_node(mesh);
-  CutResult total;
-  for (int k = 0; k < 4; ++k) {
-    const Vec3 tip = top + Vec3(-0.03 + 0.011 * k, -0.012 - 0.002 * k, -0.02 + 0.007 * k);
-    const Vec3 along = Vec3(1, 0.15 * (k % 3), 0.5 - 0.2 * k).normalized();
-    BladeEdge from{tip, tip + 0.04 * Vec3(0.3 - 0.1 * k, 1, 0.2 * k).normalized(), Vec3::UnitZ()};
-    for (int step = 0; step < 8; ++step) {
-      BladeEdge to = from;
-      to.tip += 0.003 * along;
-      to.heel += 0.003 * along;
-      const CutResult r = cut_sweep(mesh, state, from, to);
-      total.moved_nodes.insert(total.moved_nodes.end(), r.moved_nodes.begin(), r.moved_nodes.end());
-      total.flips += r.flips;
-      total.tets_split += r.tets_split;
-      from = to;
-    }
-    finish_stroke(mesh, state);
-  }
+  const CutResult total = fidelity::crossing_strokes(mesh, state, 4);
   // All three kinds of change happened.
   EXPECT_GT(total.tets_split, 100);
   EXPECT_FALSE(total.moved_nodes.empty());
