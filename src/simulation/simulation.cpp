@@ -104,7 +104,7 @@ struct Simulation::Impl {
 
   bool cutting_enabled = true;
   std::uint64_t steps = 0, surface_version = 0, mesh_version = 0;
-  int cuts = 0, tets_split = 0;
+  int cuts = 0, tets_split = 0, nodes_smoothed = 0, flips = 0;
   long cg_iterations_total = 0;
   long solver_fallbacks = 0;
   StepStats last;
@@ -176,7 +176,7 @@ struct Simulation::Impl {
     last_rest_edge.clear();
     blade_imposed.clear();
     steps = 0;
-    cuts = tets_split = 0;
+    cuts = tets_split = nodes_smoothed = flips = 0;
     cg_iterations_total = 0;
     solver_fallbacks = 0;
     last = StepStats{};
@@ -367,6 +367,8 @@ struct Simulation::Impl {
     cut_since_solve = true;
     rebuild_surface_tree();
     s.assembly_ms += ms_since(t0);
+    nodes_smoothed += r.nodes_smoothed;
+    flips += r.flips;
     // Only nodes moved (the last stroke's smoothing at a new stroke's first band, or a node
     // taken onto a cut that opened nothing there): the mesh changed, but nothing was cut.
     if (!r.cut_anything()) return false;
@@ -1055,6 +1057,8 @@ ModelCounts Simulation::counts() const {
   c.cuts = impl_->cuts;
   c.tets_split = impl_->tets_split;
   c.free_pieces_held = impl_->free_pieces_held;
+  c.nodes_smoothed = impl_->nodes_smoothed;
+  c.flips = impl_->flips;
   c.cg_iterations_total = impl_->cg_iterations_total;
   c.solver_fallbacks = impl_->solver_fallbacks;
   c.volume_initial = total_volume(impl_->initial.mesh);

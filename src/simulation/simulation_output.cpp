@@ -39,6 +39,8 @@ std::string Simulation::stats_json(double total_ms, const StepTimes* steps) {
   j["cuts"] = c.cuts;
   j["tets_split"] = c.tets_split;
   j["free_pieces_held"] = c.free_pieces_held;
+  j["nodes_smoothed"] = c.nodes_smoothed;
+  j["flips"] = c.flips;
   if (const RegionMoveStats* m = region_moves()) {  // `follow` region
     std::vector<double> d = m->durations_ms;
     std::sort(d.begin(), d.end());

@@ -17,6 +17,9 @@ struct HybridModelCounts {
 // The sizes of the current state (after cuts) plus the totals since the start (or reset).
 struct ModelCounts : HybridModelCounts {
   int cuts = 0, tets_split = 0, free_pieces_held = 0;
+  // Shape upkeep after each stroke (docs/DESIGN.md section 8, "Smooth" and "Flip"): nodes the
+  // smoothing moved, flips made (2-3 face flips and edge removals).
+  int nodes_smoothed = 0, flips = 0;
   long cg_iterations_total = 0;  // every CG iteration since the start (or the last reset)
   long solver_fallbacks = 0;     // gl solves finished on the cpu since the start (or reset)
   double volume_initial = 0, volume_final = 0;

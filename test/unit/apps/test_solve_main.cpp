@@ -135,7 +135,7 @@ TEST(SolveCli, LiverOutputMatchesFullModelIncludingInteriorNodes) {
   for (const char* key :
        {"nodes", "tets", "dof_operation", "nodes_interface", "nodes_surface_condensed",
         "nodes_interior_condensed", "cuts", "tets_split", "volume_initial", "volume_final",
-        "cg_iterations", "residual", "backend", "timings_ms"})
+        "cg_iterations", "residual", "backend", "timings_ms", "nodes_smoothed", "flips"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["nodes"], scene.mesh.num_nodes());
   EXPECT_EQ(j["tets"], scene.mesh.num_tets());
