@@ -59,17 +59,15 @@ std::array<int, 3> TetGrid::cell_of(const Vec3& p) const {
   return c;
 }
 
-void TetGrid::keep_box(const TetMesh& mesh, int tet) {
+void TetGrid::refresh(const TetMesh& mesh, int tet) {
   if (boxes_.size() < mesh.tets.size())
     boxes_.resize(mesh.tets.size(), Box{Vec3::Zero(), Vec3::Zero()});
   Box& box = boxes_[static_cast<size_t>(tet)];
   tet_bounds(mesh, tet, box.lo, box.hi);
 }
 
-void TetGrid::refresh(const TetMesh& mesh, int tet) { keep_box(mesh, tet); }
-
 void TetGrid::insert(const TetMesh& mesh, int tet) {
-  keep_box(mesh, tet);
+  refresh(mesh, tet);
   const Box& box = boxes_[static_cast<size_t>(tet)];
   const auto a = cell_of(box.lo), b = cell_of(box.hi);
   for (int k = a[2]; k <= b[2]; ++k)
@@ -85,7 +83,7 @@ std::vector<int> TetGrid::query(const TetMesh& mesh, const Vec3& lo, const Vec3&
     stamp_ = 1;
   }
   std::vector<int> found;
-  first_overlapping(mesh, lo, hi, [&](int t, const Vec3&, const Vec3&) {
+  first_overlapping(lo, hi, [&](int t, const Vec3&, const Vec3&) {
     if (seen_[t] != stamp_) found.push_back(t);  // a tet listed in several cells: once
     seen_[t] = stamp_;
     return false;
@@ -94,13 +92,13 @@ std::vector<int> TetGrid::query(const TetMesh& mesh, const Vec3& lo, const Vec3&
   return found;
 }
 
-bool TetGrid::any(const TetMesh& mesh, const Vec3& lo, const Vec3& hi) const {
-  return first_overlapping(mesh, lo, hi, [](int, const Vec3&, const Vec3&) { return true; });
+bool TetGrid::any(const TetMesh&, const Vec3& lo, const Vec3& hi) const {
+  return first_overlapping(lo, hi, [](int, const Vec3&, const Vec3&) { return true; });
 }
 
-void TetGrid::grow_by_overlapping(const TetMesh& mesh, const Vec3& lo, const Vec3& hi, Vec3& ulo,
+void TetGrid::grow_by_overlapping(const TetMesh&, const Vec3& lo, const Vec3& hi, Vec3& ulo,
                                   Vec3& uhi) const {
-  first_overlapping(mesh, lo, hi, [&](int, const Vec3& a, const Vec3& b) {
+  first_overlapping(lo, hi, [&](int, const Vec3& a, const Vec3& b) {
     ulo = ulo.cwiseMin(a);
     uhi = uhi.cwiseMax(b);
     return false;

@@ -41,7 +41,7 @@ class TetGrid {
   // Calls stop(t, box_lo, box_hi) for every listed tet (once per cell it is listed in) whose
   // box overlaps [lo, hi], until it returns true; returns whether it did.
   template <class Stop>
-  bool first_overlapping(const TetMesh&, const Vec3& lo, const Vec3& hi, Stop stop) const {
+  bool first_overlapping(const Vec3& lo, const Vec3& hi, Stop stop) const {
     const auto a = cell_of(lo), b = cell_of(hi);
     for (int k = a[2]; k <= b[2]; ++k)
       for (int j = a[1]; j <= b[1]; ++j)
@@ -57,7 +57,6 @@ class TetGrid {
   struct Box {
     Vec3 lo, hi;
   };
-  void keep_box(const TetMesh& mesh, int tet);
   Vec3 origin_ = Vec3::Zero();
   double cell_size_ = 1.0;
   std::array<int, 3> dims_ = {1, 1, 1};
