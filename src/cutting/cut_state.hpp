@@ -32,6 +32,7 @@ struct CutState {
   // that only appear when this sweep splits the tets around them, and that this sweep's own
   // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
+  std::vector<int> last_sweep_bands;  // how many of last_sweep each band gave, oldest first
   // The same stroke's bands as a face's corners are checked against: less of the margin ahead
   // of the motion (CutOptions::corner_margin_fraction), same cap.
   std::vector<std::array<Vec3, 3>> last_corners;

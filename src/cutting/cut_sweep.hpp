@@ -26,6 +26,14 @@ CutResult cut_sweep(TetMesh& mesh, CutState& state, const BladeEdge& from, const
 CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from,
                    const std::vector<Vec3>& to, const CutOptions& options = {});
 
+// The stroke's bands (`stroke`, `bands` of its triangles each, oldest first: CutState's
+// last_sweep and last_sweep_bands) as the mark phase tests them: walking back from the newest,
+// a band is kept when the corners of its first triangle lie `spacing` or more from those of
+// the last band kept; the newest and the oldest always (docs/DESIGN.md section 8, "Spaced
+// bands"). All of `stroke` when the counts do not add up to it.
+std::vector<std::array<Vec3, 3>> spaced_bands(const std::vector<std::array<Vec3, 3>>& stroke,
+                                              const std::vector<int>& bands, double spacing);
+
 // A segment of the cut surface's border (the tip's path, the heel's, where a stroke starts),
 // lying on triangle `triangle` of a cut_triangles call.
 struct CutBorder {
@@ -47,12 +55,15 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
 // skin_slack: as mark_faces_on_triangle's (triangle_cut.hpp).
 // corner_surface: the surface a marked face's corners must lie on (default: the triangles and
 // also_mark_in).
+// marked_in: the earlier triangles whose faces are marked (default also_mark_in): a slow
+// stroke's bands thinned (cut_band).
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options = {},
                         const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
                         const std::vector<CutBorder>& borders = {},
                         double skin_slack = kSkinCornerSlack,
-                        const std::vector<std::array<Vec3, 3>>* corner_surface = nullptr);
+                        const std::vector<std::array<Vec3, 3>>* corner_surface = nullptr,
+                        const std::vector<std::array<Vec3, 3>>* marked_in = nullptr);
 
 }  // namespace stc

@@ -77,6 +77,81 @@ TEST(CutBox, CutAlongNodePlaneSplitsNothing) {
   expect_invariants(mesh, state, v0);
 }
 
+// A slow stroke through the cube (0.1 mm a step; the cube's front margin is ~3 mm), its band
+// a polyline of `points` along the blade: the stroke keeps every band and how many triangles
+// each gave, also once the kept list is capped, and the mark phase's thinned list keeps the
+// newest and the oldest band and one per spacing between, each dropped band within the
+// spacing of a kept one.
+void expect_spaced_bands(int points, int steps) {
+  TetMesh mesh = cube_mesh();
+  CutState state = make_cut_state(mesh, {}, {});
+  auto line = [points](double y) {
+    std::vector<Vec3> out;
+    for (int i = 0; i < points; ++i)
+      out.push_back(Vec3(0.0213, y, -0.005 + 0.05 * i / (points - 1)));
+    return out;
+  };
+  const double step = 1e-4;
+  for (int k = 0; k < steps; ++k)
+    cut_band(mesh, state, line(0.005 + k * step), line(0.005 + (k + 1) * step));
+  const auto& stroke = state.last_sweep;
+  const std::vector<int>& bands = state.last_sweep_bands;
+  long total = 0;
+  for (int count : bands) {
+    EXPECT_GT(count, 0);
+    EXPECT_LE(count, 2 * (points - 1));
+    total += count;
+  }
+  ASSERT_EQ(total, static_cast<long>(stroke.size()));
+  EXPECT_LE(stroke.size(), 1024u);
+  if (2 * (points - 1) * steps <= 1024) {
+    EXPECT_EQ(bands.size(), static_cast<size_t>(steps));
+  }
+
+  const double spacing = 1e-3;  // ten steps
+  const auto kept = spaced_bands(stroke, bands, spacing);
+  // Which bands were kept: `kept` is a subsequence of whole bands.
+  std::vector<size_t> first;  // each band's first triangle in `stroke`
+  size_t at = 0;
+  for (int count : bands) first.push_back(at), at += static_cast<size_t>(count);
+  std::vector<size_t> kept_bands;
+  size_t next = 0;
+  for (size_t b = 0; b < bands.size() && next < kept.size(); ++b)
+    if (kept[next][0] == stroke[first[b]][0] && kept[next][1] == stroke[first[b]][1] &&
+        kept[next][2] == stroke[first[b]][2]) {
+      kept_bands.push_back(b);
+      next += static_cast<size_t>(bands[b]);
+    }
+  ASSERT_EQ(next, kept.size()) << "not a subsequence of whole bands";
+  ASSERT_GE(kept_bands.size(), 2u);
+  EXPECT_EQ(kept_bands.front(), 0u);
+  EXPECT_EQ(kept_bands.back(), bands.size() - 1);
+  const double travel = step * static_cast<double>(bands.size() - 1);
+  EXPECT_LE(kept_bands.size(), static_cast<size_t>(travel / spacing) + 3);
+  EXPECT_GE(kept_bands.size(), static_cast<size_t>(travel / spacing));
+  auto apart = [&](size_t a, size_t b) {
+    double d = 0;
+    for (int v = 0; v < 3; ++v) d = std::max(d, (stroke[first[a]][v] - stroke[first[b]][v]).norm());
+    return d;
+  };
+  for (size_t i = 1; i < kept_bands.size(); ++i)
+    for (size_t b = kept_bands[i - 1] + 1; b < kept_bands[i]; ++b)
+      EXPECT_LT(apart(b, kept_bands[i]), spacing) << "band " << b << " dropped";
+  for (size_t i = 1; i + 1 < kept_bands.size(); ++i)
+    EXPECT_GE(apart(kept_bands[i], kept_bands[i + 1]), spacing);
+  // Counts that do not describe the list: all of it.
+  std::vector<int> wrong = bands;
+  wrong.back() += 1;
+  EXPECT_EQ(spaced_bands(stroke, wrong, spacing).size(), stroke.size());
+  EXPECT_EQ(spaced_bands(stroke, {}, spacing).size(), stroke.size());
+}
+
+TEST(CutBox, SlowStrokeKeepsItsBandsAndTheMarkPhaseASpacedSubset) {
+  expect_spaced_bands(2, 60);
+  // Three segments, six triangles a band: past the 1,024 kept, the oldest band partly dropped.
+  expect_spaced_bands(4, 180);
+}
+
 }  // namespace
 }  // namespace stc
 
