@@ -173,7 +173,8 @@ BENCHMARK(BM_StepDuringMove)
 // 0.5 mm per step; organ scale: the liver above (2 cm ball), pressed 1 cm in and drawn 4 cm
 // at 0.05 mm per step (5 mm/s). Counters: every step's wall time (median, p90, max), the
 // steps that swapped a moved region in and those that cut (median, max; and the medians of a
-// cutting step's phases: collision, insertion, model update, solve), moves, tets added.
+// cutting step's phases: collision, insertion, model update, solve), how far the cut lagged
+// behind the blade and the longest catch-up after a move, moves, tets added.
 void BM_OnlineFollowStroke(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));
   Scene scene;
@@ -207,6 +208,11 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
   // Where a cutting step goes: its phases' medians (Simulation's StepStats).
   std::vector<double> cut_collision, cut_insertion, cut_update, cut_solve;
   int moves = 0, tets_added = 0;
+  // How far the cut lags behind the blade (StepStats::cut_lag), and the longest catch-up: the
+  // steps in a row with sweeps still waiting and no move under way (cutting the backlog a
+  // move left, waiting_cut_budget_ms a step).
+  double lag_max = 0;
+  int catch_up = 0, catch_up_max = 0;
   for (auto _ : state) {
     state.PauseTiming();
     Simulation sim(scene);
@@ -217,6 +223,9 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
       next += std::chrono::milliseconds(10);
       const StepStats s = sim.step(pose);
       steps.push_back(s.step_ms);
+      lag_max = std::max(lag_max, s.cut_lag);
+      catch_up = s.sweeps_waiting > 0 && !s.region_moving ? catch_up + 1 : 0;
+      catch_up_max = std::max(catch_up_max, catch_up);
       if (s.region_moved) swaps.push_back(s.step_ms);
       if (s.cutting) {
         cuts.push_back(s.step_ms);
@@ -246,6 +255,8 @@ void BM_OnlineFollowStroke(benchmark::State& state) {
   state.counters["cutting_insertion_median_ms"] = at(cut_insertion, 0.5);
   state.counters["cutting_model_update_median_ms"] = at(cut_update, 0.5);
   state.counters["cutting_solve_median_ms"] = at(cut_solve, 0.5);
+  state.counters["cut_lag_max_mm"] = 1e3 * lag_max;
+  state.counters["catch_up_steps_max"] = catch_up_max;
   state.counters["moves"] = moves;
   state.counters["tets_added"] = tets_added;
   state.SetLabel(which == 0 ? "thigh_follow (paper scale), 0.5 mm per 10 ms step"

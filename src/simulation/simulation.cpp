@@ -861,6 +861,9 @@ struct Simulation::Impl {
       drain_sweeps(s, options.wait_for_region_moves);
       maybe_move_region(blade);
       s.region_moving = follower->moving();
+      s.sweeps_waiting = static_cast<int>(pending_sweeps.size());
+      for (const Sweep& sw : pending_sweeps)
+        s.cut_lag += (sw.to.position - sw.from.position).norm();
       s.collision_ms += ms_since(t0) - (s.cutting_ms + s.assembly_ms - cut_ms);
     }
     // A stroke that ended (the blade left the tissue or its incision, or was removed) opens

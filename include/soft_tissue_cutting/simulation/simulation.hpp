@@ -42,9 +42,10 @@ struct SimulationOptions {
   // `follow` region, online: the sweeps that waited for a move are cut for about this long
   // per step (ms; another run of them only while the step's runs so far, at their average
   // cost, leave room for it; the rest wait for the next steps), so a step after a swap does
-  // not cut the whole backlog at once (docs/DESIGN.md section 10a, "Swap"). Offline
-  // (wait_for_region_moves) every waiting sweep is cut at once.
-  double waiting_cut_budget_ms = 8.0;
+  // not cut the whole backlog at once (docs/DESIGN.md section 10a, "Swap"): half the organ-scale
+  // 10 ms step, the rest for the step's solve. Offline (wait_for_region_moves) every waiting
+  // sweep is cut at once.
+  double waiting_cut_budget_ms = 5.0;
   // Organ-scale meshes refactor a grown frame ahead on a second thread (docs/DESIGN.md section
   // 6.2, "Refactored ahead"). On, the next cut awaits that factor (offline: deterministic, every
   // run solves with the same factors); off (online), a cut takes it once it is ready and the
@@ -76,6 +77,11 @@ struct StepStats {
   // `follow` region: a re-condensation runs on the worker after this step (the cut waits),
   // or this step swapped the moved region's model in (region_follower.hpp).
   bool region_moving = false, region_moved = false;
+  // `follow` region, online: how far the cut lags behind the blade after this step - the
+  // sweeps still waiting to be cut (for a move, or for the next steps' cutting budget,
+  // SimulationOptions::waiting_cut_budget_ms) and the blade's travel over them (m).
+  int sweeps_waiting = 0;
+  double cut_lag = 0;
   // No recovery_ms: a step never recovers the condensed surface (surface() does, on demand).
   double collision_ms = 0, cutting_ms = 0, assembly_ms = 0, solve_ms = 0;
   double step_ms = 0;

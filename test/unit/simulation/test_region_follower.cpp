@@ -435,7 +435,7 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   SimulationOptions unhurried;
   unhurried.waiting_cut_budget_ms = 0;
   Simulation paced(scene, unhurried);
-  int swaps = 0, swaps_cutting = 0, cutting_steps = 0;
+  int swaps = 0, swaps_cutting = 0, cutting_steps = 0, waited = 0;
   for (const BladePose& p : poses) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));  // a 100 Hz loop: moves finish
     const StepStats st = paced.step(p);
@@ -447,9 +447,19 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
     swaps += st.region_moved;
     swaps_cutting += st.region_moved && st.cutting;
     cutting_steps += st.cutting;
+    // The lag the step reports: the waiting sweeps' travel, each at most this stroke's
+    // largest step (1.1 mm: the lift), nothing when none waits.
+    EXPECT_GE(st.sweeps_waiting, 0);
+    EXPECT_LE(st.cut_lag, 1.1e-3 * st.sweeps_waiting + 1e-12) << "step " << st.step;
+    EXPECT_EQ(st.cut_lag > 0, st.sweeps_waiting > 0) << "step " << st.step;
+    waited = std::max(waited, st.sweeps_waiting);
   }
+  EXPECT_GT(waited, 0);  // the sweeps waited for the moves (and their catch-up)
+
   paced.settle_region_move();
-  paced.step(std::nullopt);
+  const StepStats after = paced.step(std::nullopt);
+  EXPECT_EQ(after.sweeps_waiting, 0);  // settled: every waiting sweep is cut
+  EXPECT_EQ(after.cut_lag, 0);
   const double paced_opened = 0.5 * test::open_cut_area(paced.mesh());
   const double paced_error = test::relative_error_vs_full_model(paced);
   std::printf(
