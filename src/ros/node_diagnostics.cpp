@@ -42,6 +42,8 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const LoopHealth h = monitor_.report(LoopMonitor::Clock::now());
   std::string backend, renderer, note, failure, solved_by, fallback;
   std::optional<RegionMoveStats> moves;
+  int sweeps_waiting = 0;
+  double cut_lag = 0;
   {
     std::lock_guard<std::mutex> lock(info_mutex_);
     backend = backend_;
@@ -51,6 +53,8 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     solved_by = solved_by_;
     fallback = fallback_reason_;
     moves = region_moves_;
+    sweeps_waiting = sweeps_waiting_;
+    cut_lag = cut_lag_;
   }
   const double period_ms = 1000.0 / params_.rate;
   std::string summary = h.level == LoopHealth::kOk ? h.summary + " on " + backend : h.summary;
@@ -90,6 +94,9 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
                   moves->ball.center.y(), moves->ball.center.z());
     status.add("region centre (m)", std::string(centre));
     status.add("region move reason", moves->last_reason);
+    // How far the cut trails the blade (waiting for a move, or cut a few ms a step after one).
+    status.add("sweeps waiting", sweeps_waiting);
+    status.add("cut lag (m)", cut_lag);
   }
 }
 

@@ -27,6 +27,8 @@ void TissueNode::publish_step_locked(const StepStats& s, const std::optional<Bla
     solved_by_ = s.solved_by;
     fallback_reason_ = s.fallback_reason;
     if (const RegionMoveStats* m = sim_->region_moves()) region_moves_ = *m;  // `follow`
+    sweeps_waiting_ = s.sweeps_waiting;
+    cut_lag_ = s.cut_lag;
   }
   wrench_pub_.publish(wrench);
 }

@@ -139,10 +139,13 @@ TEST_F(Fixture, StrokeLongerThanTheRegionCutsEndToEnd) {
         }
         const std::string& moving = diagnostics["region moving"];
         return diagnostics_seen >= reports + 2 && (moving == "False" || moving == "false") &&
+               diagnostics["sweeps waiting"] == "0" &&
                (ros::WallTime::now() - changed).toSec() > 1.5;
       },
       30.0))
-      << "the region kept moving (region moving: " << diagnostics["region moving"] << ")";
+      << "the region kept moving (region moving: " << diagnostics["region moving"]
+      << ", sweeps waiting: " << diagnostics["sweeps waiting"] << ")";
+  EXPECT_EQ(diagnostics["cut lag (m)"], "0");  // every sweep cut: the cut reached the blade
   const double total_s = (ros::WallTime::now() - start).toSec();
 
   // The stroke: the poses at the deepest x (the edge points radially out, +x; the draw along z).

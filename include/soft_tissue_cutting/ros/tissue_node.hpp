@@ -193,6 +193,8 @@ class TissueNode {
   std::string solver_failure_;                   // why the last non-converged solve failed
   std::string solved_by_, fallback_reason_;      // the last step's (cpu when a gl solve fell back)
   std::optional<RegionMoveStats> region_moves_;  // `follow` region: as of the last step
+  int sweeps_waiting_ = 0;                       // `follow`: the last step's (StepStats)
+  double cut_lag_ = 0;                           // m
   std::uint64_t steps_ = 0;                      // loop thread
   std::uint64_t poses_dropped_seen_ = 0;         // loop thread: pose_input_.dropped() last warned
 
