@@ -29,9 +29,11 @@ TetGrid grid_of(const TetMesh& mesh, const std::vector<std::uint8_t>& include) {
 }  // namespace
 
 void apply_partition_to_cut_state(MovedRegion& moved, CutState& state) {
-  state.cuttable = std::move(moved.cuttable);
-  state.locked = std::move(moved.locked);
-  state.grid = std::move(moved.cut_grid);
+  // Swapped, not moved: the old partition's view is left in `moved`, for the caller to free
+  // off the loop (the grids are many small vectors).
+  std::swap(state.cuttable, moved.cuttable);
+  std::swap(state.locked, moved.locked);
+  std::swap(state.grid, moved.cut_grid);
 }
 
 RegionFollower::RegionFollower(const Sphere& ball, const HybridModel& model, double spacing)
@@ -228,7 +230,7 @@ void RegionFollower::adopted(MovedRegion& moved) {
   ++stats_.moves;
   stats_.ball.center = moved.centre;
   stats_.last_wait_ms = ms_since(requested_at_);
-  condensed_grid_ = std::move(moved.condensed_grid);
+  std::swap(condensed_grid_, moved.condensed_grid);  // the old one left in `moved` (above)
 }
 
 void RegionFollower::dropped() { ++stats_.failed; }

@@ -50,6 +50,7 @@ struct MovedRegion {
 // The cutter's view of a partition (same rule as make_cut_state): only part-1 tets are
 // cuttable and every node of a condensed tet is locked (never duplicated), so K0 and the
 // recovery stay valid. Keeps the state's history (size classes, node stars, the stroke).
+// The state's old view is left in `moved`.
 void apply_partition_to_cut_state(MovedRegion& moved, CutState& state);
 
 class RegionFollower {
