@@ -14,4 +14,5 @@ list(APPEND TISSUE_CORE_SOURCES
   src/cutting/tet_flips.cpp
   src/cutting/tet_grid.cpp
   src/cutting/triangle_cut.cpp
+  src/cutting/vertex_insertion.cpp
 )

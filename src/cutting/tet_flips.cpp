@@ -1,6 +1,7 @@
 #include "cutting/tet_flips.hpp"
 
 #include "cutting/triangle_cut.hpp"
+#include "cutting/vertex_insertion.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
@@ -37,7 +38,13 @@ double smallest_volume_ratio(const TetMesh& mesh, const std::vector<Tet>& tets) 
 
 // A replacement of the tets `cavity` by `tets` (positively oriented) over the same region.
 struct Flip {
-  bool face = false;  // a 2-3 flip (else an edge removal)
+  bool face = false;  // a 2-3 flip (else an edge removal or an insertion)
+  // A vertex insertion (vertex_insertion.hpp): `tets` use kInsertedNode for a new node at
+  // `point`, inside the tet `host` at barycentric `weights`.
+  bool insert = false;
+  Vec3 point = Vec3::Zero();
+  Tet host{};
+  std::array<double, 4> weights{};
   std::vector<int> cavity;
   std::vector<Tet> tets;
   double size_class = 0;  // the smallest of the cavity's: the new tets'
@@ -191,6 +198,20 @@ bool edge_removal(const TetMesh& mesh, const CutState& state, int a, int b, doub
   return true;
 }
 
+Flip as_flip(const VertexInsertion& insertion) {
+  Flip flip;
+  flip.insert = true;
+  flip.cavity = insertion.cavity;
+  flip.tets = insertion.tets;
+  flip.size_class = insertion.size_class;
+  flip.before = insertion.before;
+  flip.after = insertion.after;
+  flip.point = insertion.point;
+  flip.host = insertion.host;
+  flip.weights = insertion.weights;
+  return flip;
+}
+
 // The last stroke's triangles (CutState::last_sweep, margins included). The same path cut once
 // more (a repeated `~cut`, which must then find nothing left to cut:
 // `RepeatedCutSaysItIsAlreadyCut` cut in 5 passes in a row with unrestricted flips) splits an edge
@@ -253,7 +274,22 @@ class SweptSurface {
 // Replaces the cavity's tets: its indices first (ascending), then appended ones; the cut marks
 // of its boundary faces go to the new tets that have those faces (the faces inside were on no
 // cut). Returns the new tets' indices.
-std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
+std::vector<int> apply(TetMesh& mesh, CutState& state, Flip flip, CutResult& result) {
+  if (flip.insert) {  // the new node first, its displacement interpolated in `host` (eq. (21))
+    NewNode node;
+    node.index = mesh.num_nodes();
+    node.kind = NewNode::Kind::kInTet;
+    node.corners = flip.host;
+    node.weights = flip.weights;
+    mesh.nodes.push_back(flip.point);
+    state.locked.push_back(0);
+    state.node_tets.emplace_back();
+    result.new_nodes.push_back(node);
+    ++result.nodes_inserted;
+    for (Tet& k : flip.tets)
+      for (int& v : k)
+        if (v == kInsertedNode) v = node.index;
+  }
   std::set<FaceKey> marked;
   for (int t : flip.cavity) {
     const Tet& k = mesh.tets[static_cast<size_t>(t)];
@@ -305,8 +341,9 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, const Flip& flip) {
 }
 
 // The best flip that removes tet t (through its faces or around its edges), if any gains.
-bool best_flip(const TetMesh& mesh, const CutState& state, int t, double guard,
-               const SweptSurface& swept, double snap, Flip& best) {
+bool best_flip(const TetMesh& mesh, const CutState& state, int t, const CutOptions& options,
+               const SweptSurface& swept, Flip& best) {
+  const double guard = 2 * options.min_volume_fraction, snap = options.snap_tolerance;
   bool found = false;
   const auto disturbs_last_stroke = [&](const Flip& candidate) {
     // A closed face of the cavity on the stroke's surface (SweptSurface): one between two of
@@ -324,6 +361,7 @@ bool best_flip(const TetMesh& mesh, const CutState& state, int t, double guard,
     return false;
   };
   const auto ratio_kept = [&](const Flip& candidate) {
+    if (candidate.insert) return true;  // vertex_insertion kept it (its tets name no node yet)
     std::vector<Tet> old;
     for (int c : candidate.cavity) old.push_back(mesh.tets[static_cast<size_t>(c)]);
     return smallest_volume_ratio(mesh, candidate.tets) >= smallest_volume_ratio(mesh, old);
@@ -344,6 +382,14 @@ bool best_flip(const TetMesh& mesh, const CutState& state, int t, double guard,
       if (edge_removal(mesh, state, k[static_cast<size_t>(i)], k[static_cast<size_t>(j)], guard,
                        candidate))
         consider(candidate);
+  // No flip brings the tet to the threshold: a node inside a cavity around it may.
+  if (options.insert_nodes && (!found || best.after < options.smooth_below_deg))
+    for (const std::vector<int>& cavity : insertion_cavities(mesh, state, t)) {
+      VertexInsertion insertion;
+      if (!vertex_insertion(mesh, state, cavity, guard, insertion)) continue;
+      candidate = as_flip(insertion);
+      consider(candidate);
+    }
   return found;
 }
 
@@ -353,7 +399,6 @@ FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& opti
                           const std::vector<int>& tets, CutResult& result) {
   FlipCounts flips;
   if (!(options.smooth_below_deg > 0)) return flips;
-  const double guard = 2 * options.min_volume_fraction;
   const SweptSurface swept(state.last_sweep);
   std::vector<int> queue = tets;
   // Two rounds: the second over the tets the first made (a flip's new tets may flip again).
@@ -366,11 +411,11 @@ FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& opti
           smallest_angle(mesh, mesh.tets[static_cast<size_t>(t)]) >= options.smooth_below_deg)
         continue;
       Flip flip;
-      if (!best_flip(mesh, state, t, guard, swept, options.snap_tolerance, flip)) continue;
-      const std::vector<int> changed = apply(mesh, state, flip);
+      if (!best_flip(mesh, state, t, options, swept, flip)) continue;
+      const std::vector<int> changed = apply(mesh, state, flip, result);
       result.changed_tets.insert(result.changed_tets.end(), changed.begin(), changed.end());
       made.insert(made.end(), changed.begin(), changed.end());
-      ++(flip.face ? flips.faces : flips.edges);
+      ++(flip.insert ? flips.insertions : flip.face ? flips.faces : flips.edges);
     }
     queue = std::move(made);
   }

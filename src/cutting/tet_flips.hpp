@@ -21,15 +21,18 @@
 namespace stc {
 
 struct FlipCounts {
-  int faces = 0;  // 2-3 flips
-  int edges = 0;  // edge removals
-  int total() const { return faces + edges; }
+  int faces = 0;       // 2-3 flips
+  int edges = 0;       // edge removals
+  int insertions = 0;  // vertex insertions (vertex_insertion.hpp)
+  int total() const { return faces + edges + insertions; }
 };
 
 // Flips that raise the smallest dihedral angle of `tets` below CutOptions::smooth_below_deg
 // (and of the tets the flips make), each by more than 0.05 deg over the tets it replaces and
-// keeping every new tet above twice CutOptions::min_volume_fraction of its size class. The
-// changed and appended tets go to result.changed_tets.
+// keeping every new tet above twice CutOptions::min_volume_fraction of its size class; where no
+// flip reaches smooth_below_deg, a vertex insertion (CutOptions::insert_nodes) is a candidate
+// too. The changed and appended tets go to result.changed_tets, an inserted node to
+// result.new_nodes.
 FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
                           const std::vector<int>& tets, CutResult& result);
 

@@ -374,6 +374,20 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     const int node = old_nodes + k;
     const NewNode& nn = new_nodes[static_cast<size_t>(k)];
     const bool split = nn.kind == NewNode::Kind::kEdgeSplit;
+    if (nn.kind == NewNode::Kind::kInTet) {
+      bool fixed = true;
+      u_.segment<3>(3 * node).setZero();
+      for (int i = 0; i < 4; ++i) {
+        const int c = nn.corners[static_cast<size_t>(i)];
+        if (c < 0 || c >= node)
+          throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
+        u_.segment<3>(3 * node) += nn.weights[static_cast<size_t>(i)] * u_.segment<3>(3 * c);
+        fixed = fixed && fixed_[static_cast<size_t>(c)];
+      }
+      fixed_[static_cast<size_t>(node)] = fixed;
+      point_loads_.segment<3>(3 * node).setZero();
+      continue;
+    }
     if (nn.a < 0 || nn.a >= node || (split && (nn.b < 0 || nn.b >= node)))
       throw std::invalid_argument("HybridModel::update_operation_part: bad parent node");
     if (split) {

@@ -320,7 +320,8 @@ struct Simulation::Impl {
     const std::vector<int> keep = simplify_polylines(*rest_from, *rest_to, 0.25e-3);
     std::vector<Vec3> band_from, band_to;
     for (int k : keep) band_from.push_back((*rest_from)[k]), band_to.push_back((*rest_to)[k]);
-    const CutResult r = cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to);
+    const CutResult r =
+        cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to, options.cut);
     s.cutting_ms += ms_since(t0);
     return adopt_cut(r, s) || finished;
   }
@@ -331,7 +332,7 @@ struct Simulation::Impl {
   bool finish_cut_stroke(StepStats& s) {
     stroke_to_finish = false;
     const auto t0 = Clock::now();
-    const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state);
+    const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state, options.cut);
     s.cutting_ms += ms_since(t0);
     return adopt_cut(r, s);
   }

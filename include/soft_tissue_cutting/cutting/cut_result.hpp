@@ -2,6 +2,7 @@
 // state (displacements, fixed flags, K^(1)) incrementally.
 #pragma once
 
+#include <array>
 #include <vector>
 
 namespace stc {
@@ -12,12 +13,15 @@ struct NewNode {
   enum class Kind {
     kEdgeSplit,  // on edge (a, b) at parameter t: initialise u = (1 - t) u_a + t u_b
     kDuplicate,  // a copy of a (a node separated by the cut): initialise u = u_a, copy flags
+    kInTet,      // inserted inside the tet `corners` at barycentric `weights`: u = sum w_k u_k
   };
   int index = -1;
   Kind kind = Kind::kEdgeSplit;
   int a = -1;
   int b = -1;  // kEdgeSplit only
   double t = 0;
+  std::array<int, 4> corners{};     // kInTet only
+  std::array<double, 4> weights{};  // kInTet only
 };
 
 struct CutOptions {
@@ -44,6 +48,11 @@ struct CutOptions {
   // an edge removal (4-4 to 7-10) over interior faces on no cut raises the smallest angle
   // (cutting/tet_flips.hpp): no node and no surface moves. false: smoothing only.
   bool flip_thin_tets = true;
+  // Where no flip brings such a tet to smooth_below_deg, a new node inside a small cavity
+  // around it (the tet and its neighbours across faces on no cut, or an edge's ring), joined
+  // to the cavity's boundary faces, is a candidate too (cutting/vertex_insertion.hpp; only with
+  // flip_thin_tets).
+  bool insert_nodes = true;
   // No split may leave a tet below this fraction of its size class (the volume of the input
   // tet it descends from). A split that would is refused by snapping its nearer end instead;
   // docs/SCENE.md "Cut invariants": "small fraction" is this number. With snap 0.1 a tet can be cut
@@ -84,10 +93,16 @@ struct CutResult {
   // Flips the last stroke's tets took at the same time (cutting/tet_flips.hpp): connectivity,
   // not a cut.
   int flips = 0;
+  // Of new_nodes, how many the flips inserted inside a cavity (cutting/tet_flips.hpp): shape,
+  // not a cut.
+  int nodes_inserted = 0;
   // Did the cut split, add or mark anything? (Moving nodes alone - the smoothing, or a node
   // relocated onto a cut that opened nothing there - changes the mesh's shape, not its cut:
   // the same stroke again relocates what the last one's smoothing moved off it.)
-  bool cut_anything() const { return tets_split > 0 || !new_nodes.empty() || cut_faces_added != 0; }
+  bool cut_anything() const {
+    return tets_split > 0 || static_cast<int>(new_nodes.size()) > nodes_inserted ||
+           cut_faces_added != 0;
+  }
 };
 
 }  // namespace stc

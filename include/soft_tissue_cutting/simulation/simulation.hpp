@@ -3,6 +3,7 @@
 // and the offline `./tissue solve` both drive this class.
 #pragma once
 
+#include "soft_tissue_cutting/cutting/cut_result.hpp"  // CutOptions
 #include "soft_tissue_cutting/gpu/gl_context_options.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/scene/scene.hpp"
@@ -51,6 +52,9 @@ struct SimulationOptions {
   // run solves with the same factors); off (online), a cut takes it once it is ready and the
   // loop never waits for it (the solutions differ by rounding only).
   bool wait_for_factor_ahead = false;
+  // The cutter's options (docs/DESIGN.md section 8); the defaults are what it describes. Tests
+  // switch a stage off to measure what it does (e.g. insert_nodes).
+  CutOptions cut;
 };
 
 // Stage timings and outcome of one step.

@@ -11,4 +11,5 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_earlier_triangles.cpp
   test/unit/cutting/test_tet_flips.cpp
   test/unit/cutting/test_tet_grid.cpp
+  test/unit/cutting/test_vertex_insertion.cpp
 )

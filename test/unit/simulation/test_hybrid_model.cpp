@@ -246,6 +246,71 @@ TEST(HybridModel, UpdateOperationPartMatchesFullModelOnNewMesh) {
   EXPECT_THROW(h.update_operation_part({part2}, {}), std::logic_error);
 }
 
+// A node inserted inside part-1 tet t at barycentric w (the tet becomes four through it, as a
+// vertex insertion's cavity of one tet would): its displacement starts at sum w_k u_k, and the
+// hybrid solution still matches the full model's on the new mesh.
+TEST(HybridModel, ANodeInsertedInATetStartsInterpolatedAndSolvesAsTheFullModel) {
+  HybridModel h(thigh_with(OperationRegion::Kind::kSphere, true));
+  h.set_cg_settings(CgSettings{kTight, 20000});
+  h.solve();
+  const HybridModelCounts before = h.counts();
+  TetMesh& m = h.mesh_for_cutting();
+  int t = -1;  // a part-1 tet with no interface node
+  for (int c : h.partition().operation_tets) {
+    bool inner = true;
+    for (int v : m.tets[static_cast<size_t>(c)])
+      inner = inner && h.partition().node_set[static_cast<size_t>(v)] == NodeSet::kOperation;
+    if (inner) {
+      t = c;
+      break;
+    }
+  }
+  ASSERT_GE(t, 0);
+  const Tet host = m.tets[static_cast<size_t>(t)];
+  const std::array<double, 4> w = {0.1, 0.2, 0.3, 0.4};
+  const int node = m.num_nodes();
+  Vec3 x = Vec3::Zero(), u = Vec3::Zero();
+  for (size_t i = 0; i < 4; ++i) {
+    x += w[i] * m.nodes[static_cast<size_t>(host[i])];
+    u += w[i] * h.displacement().segment<3>(3 * host[i]);
+  }
+  m.nodes.push_back(x);
+  std::vector<int> changed = {t};
+  for (size_t i = 0; i < 4; ++i) {
+    Tet k = host;
+    k[i] = node;
+    if (i == 0) {
+      m.tets[static_cast<size_t>(t)] = k;
+    } else {
+      m.tets.push_back(k);
+      if (!m.cut_faces.empty()) m.cut_faces.push_back(0);
+      changed.push_back(m.num_tets() - 1);
+    }
+  }
+  NewNode inserted;
+  inserted.index = node;
+  inserted.kind = NewNode::Kind::kInTet;
+  inserted.corners = host;
+  inserted.weights = w;
+  h.update_operation_part(changed, {inserted});
+  EXPECT_LT((h.displacement().segment<3>(3 * node) - u).norm(), 1e-15);
+  EXPECT_EQ(h.counts().nodes, before.nodes + 1);
+  EXPECT_EQ(h.counts().tets, before.tets + 3);
+  EXPECT_EQ(h.counts().dof_operation, before.dof_operation + 3);
+  const CgResult r = h.solve();
+  EXPECT_TRUE(r.converged);
+  const Reference ref = full_reference(h);
+  h.recover_interior();
+  const double e = nodal_error(h.displacement(), ref.u, all_nodes(h.mesh()));
+  EXPECT_LE(e, 1e-9);
+  // A corner index past the new node is refused.
+  NewNode bad = inserted;
+  bad.index = node + 1;
+  bad.corners[0] = node + 1;
+  m.nodes.push_back(x);
+  EXPECT_THROW(h.update_operation_part({}, {bad}), std::invalid_argument);
+}
+
 TEST(HybridModel, CutsUpdateTheMatrixAsAFreshAssemblyWould) {
   Scene scene = make_thigh_scene();
   scene.trajectory = resample_blade_path(scene.trajectory, scene.scalpel.blade_length, 1e-3);

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -184,6 +185,34 @@ int stroke_count(int ci_default) {
 // the CG iterations of the solve after each stroke are reported after 100 strokes and at the end
 // (issue 9 item 4 asks for >= 5 deg, not met - see README - and <= 2x the uncut mesh's
 // iterations, met and asserted).
+// One random stroke of the sagging TetGen liver tests: 3 cm at most, from within 2 cm of the
+// operation region's centre (biased down into the tissue), any blade orientation.
+std::vector<BladePose> random_liver_stroke(std::mt19937& rng, const Vec3& centre) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  BladePose a, b;
+  a.position = centre + 0.02 * Vec3(unit(rng), unit(rng) - 0.5, unit(rng));
+  b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
+  a.orientation =
+      Eigen::Quaterniond(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
+  b.orientation = a.orientation;
+  return {a, b};
+}
+
+// Tets of the operation part under 5 deg (the condensed part is never cut: its thin tets are
+// the input's).
+int thin_operation_tets(const Simulation& sim) {
+  int thin = 0;
+  const TetMesh& mesh = sim.mesh();
+  const auto& operation = sim.model().partition().operation_tet;
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    const Tet& e = mesh.tets[static_cast<size_t>(t)];
+    thin += operation[static_cast<size_t>(t)] &&
+            smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                                  mesh.nodes[e[3]]) < 5.0;
+  }
+  return thin;
+}
+
 TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   const int strokes = stroke_count(300);
   ASSERT_GT(strokes, 0) << "TISSUE_RANDOM_CUT_STROKES must be a positive number";
@@ -192,7 +221,6 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   const double dihedral_before = mesh_quality(sim.mesh()).min_dihedral_deg;
   const int cold_iterations = sim.last_stats().cg_iterations;
   std::mt19937 rng(20261123);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const Vec3 centre = scene.operation_region.sphere.center;
   int cuts = 0;
   std::vector<int> iterations;
@@ -223,13 +251,7 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
     }
   };
   for (int k = 0; k < strokes; ++k) {
-    BladePose a, b;
-    a.position = centre + 0.02 * Vec3(unit(rng), unit(rng) - 0.5, unit(rng));
-    b.position = a.position + 0.03 * Vec3(unit(rng), unit(rng), unit(rng));
-    a.orientation = Eigen::Quaterniond(
-        Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized());
-    b.orientation = a.orientation;
-    const CutOutcome out = sim.cut_along({a, b});
+    const CutOutcome out = sim.cut_along(random_liver_stroke(rng, centre));
     cuts += out.success;
     iterations.push_back(sim.model().last_result().iterations);
     InvariantLimits limits;
@@ -252,10 +274,11 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   EXPECT_LE(*std::max_element(iterations.begin(), iterations.end()),
             2 * std::max(cold_iterations, 1));
   // Shapes (not met: >= 5 deg asked; the input itself starts at 1.9 deg): regression guards
-  // with margin over what stop 39 measures after 100 strokes with the flips (171 tets under 5
-  // deg, min 0.55 deg; stop 38's smoothing alone 241 / 0.42, stop 37's 261 / 0.55).
+  // with margin over what stop 42 measures after 100 strokes with the vertex insertion (109
+  // tets under 5 deg, 77 of them in the operation part, min 0.72 deg; stop 39's flips 171 /
+  // 0.55, stop 38's smoothing alone 241 / 0.42, stop 37's 261 / 0.55).
   if (strokes >= 100) {
-    EXPECT_LE(thin_at_100, 210) << "tets under 5 deg after 100 strokes";
+    EXPECT_LE(thin_at_100, 140) << "tets under 5 deg after 100 strokes";
     EXPECT_GT(dihedral_at_100, 0.3) << "min dihedral after 100 strokes";
   }
   // The upkeep is counted where the run reports (stats JSON, ModelCounts): each stroke that
@@ -265,6 +288,41 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
               counts.nodes_smoothed, counts.flips);
   EXPECT_GT(counts.nodes_smoothed, 0);
   EXPECT_GT(counts.flips, 0);
+}
+
+// What the vertex insertion adds over smoothing and flips (docs/DESIGN.md section 8, "Insert";
+// issue 9 item 4): the sagging TetGen liver, 100 random strokes, four seeds, with and without
+// it. Measured (stop 42), tets of the operation part under 5 deg: seeds 1-4 without 152 / 136 /
+// 124 / 171, with 136 / 70 / 104 / 109 (-29 % in all; seeds 5, 6 and 20261123: 157 -> 106,
+// 204 -> 126, 139 -> 77); the smallest angle scatters with the cut sequence either way
+// (0.31-1.19 deg with, 0.55-1.02 without). Asserted: at least 15 % fewer over the four seeds.
+TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
+  const Scene scene = fidelity::sagging_liver();
+  const Vec3 centre = scene.operation_region.sphere.center;
+  std::array<int, 2> thin = {0, 0};
+  for (unsigned seed : {1u, 2u, 3u, 4u})
+    for (int insert = 0; insert < 2; ++insert) {
+      SimulationOptions options;
+      options.cut.insert_nodes = insert == 1;
+      Simulation sim(scene, options);
+      std::mt19937 rng(seed);
+      for (int k = 0; k < 100; ++k) sim.cut_along(random_liver_stroke(rng, centre));
+      const int here = thin_operation_tets(sim);
+      thin[static_cast<size_t>(insert)] += here;
+      std::printf(
+          "seed %u, insertion %s: %d tets, %d of the operation part under 5 deg, min %.2f deg\n",
+          seed, insert ? "on" : "off", sim.counts().tets, here,
+          mesh_quality(sim.mesh()).min_dihedral_deg);
+      InvariantLimits limits;
+      limits.initial_volume = sim.counts().volume_initial;
+      const auto violated = check_cut_invariants(sim.mesh(), sim.tet_size_classes(), limits);
+      EXPECT_TRUE(violated.empty()) << "seed " << seed << ": " << violated.front();
+      EXPECT_TRUE(sim.model().displacement().allFinite());
+    }
+  std::printf(
+      "TetGen liver, 4 x 100 strokes: operation tets under 5 deg %d without insertion, %d with\n",
+      thin[0], thin[1]);
+  EXPECT_LE(thin[1], 0.85 * thin[0]);
 }
 
 // The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k

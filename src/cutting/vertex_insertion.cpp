@@ -1,0 +1,217 @@
+#include "cutting/vertex_insertion.hpp"
+
+#include "cutting/triangle_cut.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace stc {
+namespace {
+
+const Vec3& corner(const TetMesh& mesh, int v, const Vec3& point) {
+  return v == kInsertedNode ? point : mesh.nodes[static_cast<size_t>(v)];
+}
+
+double volume_with(const TetMesh& mesh, const Tet& k, const Vec3& point) {
+  return signed_volume(corner(mesh, k[0], point), corner(mesh, k[1], point),
+                       corner(mesh, k[2], point), corner(mesh, k[3], point));
+}
+
+double angle_with(const TetMesh& mesh, const Tet& k, const Vec3& point) {
+  return smallest_dihedral_deg(corner(mesh, k[0], point), corner(mesh, k[1], point),
+                               corner(mesh, k[2], point), corner(mesh, k[3], point));
+}
+
+// The new tets' smallest dihedral angle with the node at `point`; -1 if one of them is not
+// above min_volume.
+double quality_at(const TetMesh& mesh, const std::vector<Tet>& tets, const Vec3& point,
+                  double min_volume) {
+  double q = 180;
+  for (const Tet& k : tets) {
+    if (!(volume_with(mesh, k, point) > min_volume)) return -1;
+    q = std::min(q, angle_with(mesh, k, point));
+  }
+  return q;
+}
+
+// How far `point` lies inside the cavity's boundary: the least height over a boundary face
+// (signed: negative on its outer side) in units of the face's longest edge; `towards` (if
+// given) is that face's inward normal, the direction that raises it.
+double clearance(const TetMesh& mesh, const std::vector<Tet>& tets, const Vec3& point,
+                 Vec3* towards) {
+  double least = 1e300;
+  for (const Tet& k : tets) {
+    const Vec3* face[3];
+    int n = 0;
+    for (int v : k)
+      if (v != kInsertedNode) face[n++] = &mesh.nodes[static_cast<size_t>(v)];
+    const Vec3 normal = (*face[1] - *face[0]).cross(*face[2] - *face[0]);
+    const double longest = std::max(
+        {(*face[1] - *face[0]).norm(), (*face[2] - *face[1]).norm(), (*face[0] - *face[2]).norm()});
+    const double volume = volume_with(mesh, k, point);
+    const double height = 6 * volume / normal.norm() / longest;
+    if (height < least) {
+      least = height;
+      // The new tet's volume is affine in the point, with gradient +-normal / 6: which sign
+      // from the volume at the face's centroid (zero) and at the point.
+      if (towards) {
+        const Vec3 centroid = (*face[0] + *face[1] + *face[2]) / 3;
+        const double slope = normal.dot(point - centroid);
+        *towards = (slope * volume >= 0 ? 1.0 : -1.0) * normal.normalized();
+        if (slope == 0)
+          *towards = volume_with(mesh, k, point + normal) > volume ? Vec3(normal.normalized())
+                                                                   : Vec3(-normal.normalized());
+      }
+    }
+  }
+  return least;
+}
+
+// An ascent on a max-min measure of the point (eq. (20b)'s): from x, along what raises the
+// worst term, with a step that grows on success and halves on failure. measure(p, &direction)
+// returns the measure and the direction.
+template <typename Measure>
+Vec3 ascend(Vec3 x, double scale, const Measure& measure) {
+  Vec3 along;
+  double value = measure(x, &along);
+  double step = 0.05 * scale;
+  for (int iteration = 0; iteration < 60 && step > 1e-3 * scale && along != Vec3::Zero();
+       ++iteration) {
+    Vec3 next_along;
+    const Vec3 y = x + step * along;
+    const double next = measure(y, &next_along);
+    if (next > value + 1e-9) {
+      x = y, value = next, along = next_along;
+      step = std::min(1.5 * step, 0.5 * scale);
+    } else {
+      step *= 0.5;
+    }
+  }
+  return x;
+}
+
+}  // namespace
+
+bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                      double guard, VertexInsertion& insertion) {
+  std::sort(cavity.begin(), cavity.end());
+  cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
+  insertion = VertexInsertion{};
+  insertion.cavity = cavity;
+  insertion.before = 180;
+  insertion.size_class = 1e300;
+  double volume = 0, flattest = 1e300, shortest = 1e300;
+  std::set<int> corners, on_boundary;
+  for (int c : cavity) {
+    if (!state.cuttable[static_cast<size_t>(c)]) return false;
+    const Tet& k = mesh.tets[static_cast<size_t>(c)];
+    const Vec3 &a = mesh.nodes[k[0]], &b = mesh.nodes[k[1]], &d = mesh.nodes[k[2]],
+               &e = mesh.nodes[k[3]];
+    insertion.before = std::min(insertion.before, smallest_dihedral_deg(a, b, d, e));
+    insertion.size_class =
+        std::min(insertion.size_class, state.origin_volume[static_cast<size_t>(c)]);
+    flattest = std::min(flattest, volume_ratio(a, b, d, e));
+    volume += tet_volume(mesh, c);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        shortest = std::min(shortest, (mesh.nodes[k[i]] - mesh.nodes[k[j]]).norm());
+    for (int f = 0; f < 4; ++f) {
+      corners.insert(k[static_cast<size_t>(f)]);
+      const int across = neighbour_across(mesh, state, c, f).first;
+      if (across >= 0 && std::binary_search(cavity.begin(), cavity.end(), across)) {
+        if (mesh.is_cut_face(c, f)) return false;  // a cut inside the cavity would vanish
+        continue;
+      }
+      Tet joined = k;  // the face with the new node instead of c's opposite corner: positive
+      joined[static_cast<size_t>(f)] = kInsertedNode;
+      insertion.tets.push_back(joined);
+      for (int i : kTetFaces[static_cast<size_t>(f)]) on_boundary.insert(k[static_cast<size_t>(i)]);
+    }
+  }
+  if (on_boundary.size() != corners.size()) return false;  // a corner inside would be lost
+  // Where every new tet is positive, if anywhere: the point deepest inside every boundary
+  // face, found from the best cavity tet's centroid.
+  Vec3 x = Vec3::Zero();
+  double deepest = -1e300;
+  for (int c : cavity) {
+    Vec3 centroid = Vec3::Zero();
+    for (int v : mesh.tets[static_cast<size_t>(c)])
+      centroid += mesh.nodes[static_cast<size_t>(v)] / 4;
+    const double depth = clearance(mesh, insertion.tets, centroid, nullptr);
+    if (depth > deepest) deepest = depth, x = centroid;
+  }
+  x = ascend(x, shortest,
+             [&](const Vec3& p, Vec3* along) { return clearance(mesh, insertion.tets, p, along); });
+  const double min_volume = guard * insertion.size_class;
+  if (!(quality_at(mesh, insertion.tets, x, min_volume) > 0)) return false;
+  // Then the best smallest angle (its direction: the worst new tet's gradient, by central
+  // differences), staying valid.
+  const double eps = 1e-4 * shortest;
+  x = ascend(x, shortest, [&](const Vec3& p, Vec3* along) {
+    const double q = quality_at(mesh, insertion.tets, p, min_volume);
+    const Tet* worst = &insertion.tets.front();
+    double worst_angle = 1e300;
+    for (const Tet& k : insertion.tets)
+      if (const double angle = angle_with(mesh, k, p); angle < worst_angle)
+        worst_angle = angle, worst = &k;
+    Vec3 gradient;
+    for (int i = 0; i < 3; ++i) {
+      Vec3 up = p, down = p;
+      up[i] += eps;
+      down[i] -= eps;
+      gradient[i] = (angle_with(mesh, *worst, up) - angle_with(mesh, *worst, down)) / (2 * eps);
+    }
+    *along = gradient.norm() > 0 ? Vec3(gradient.normalized()) : Vec3::Zero();
+    return q;
+  });
+  insertion.after = quality_at(mesh, insertion.tets, x, min_volume);
+  if (!(insertion.after > 0)) return false;
+  double tiled = 0, flattest_new = 1e300;
+  for (const Tet& k : insertion.tets) {
+    tiled += volume_with(mesh, k, x);
+    flattest_new =
+        std::min(flattest_new, volume_ratio(corner(mesh, k[0], x), corner(mesh, k[1], x),
+                                            corner(mesh, k[2], x), corner(mesh, k[3], x)));
+  }
+  if (std::abs(tiled - volume) > 1e-12 * volume || flattest_new < flattest) return false;
+  // The cavity tet that holds the point (the most inside one: round-off on a shared face).
+  double inside = -1e300;
+  for (int c : cavity) {
+    const Tet& k = mesh.tets[static_cast<size_t>(c)];
+    const double v = tet_volume(mesh, c);
+    std::array<double, 4> w{};
+    for (int i = 0; i < 4; ++i) {
+      Tet sub = k;
+      sub[static_cast<size_t>(i)] = kInsertedNode;
+      w[static_cast<size_t>(i)] = volume_with(mesh, sub, x) / v;
+    }
+    if (const double least = *std::min_element(w.begin(), w.end()); least > inside)
+      inside = least, insertion.host = k, insertion.weights = w;
+  }
+  insertion.point = x;
+  return inside > -1e-9;
+}
+
+std::vector<std::vector<int>> insertion_cavities(const TetMesh& mesh, const CutState& state,
+                                                 int t) {
+  std::vector<std::vector<int>> cavities;
+  std::vector<int> around = {t};
+  for (int f = 0; f < 4; ++f) {
+    if (mesh.is_cut_face(t, f)) continue;
+    const int across = neighbour_across(mesh, state, t, f).first;
+    if (across >= 0) around.push_back(across);
+  }
+  cavities.push_back(std::move(around));
+  const Tet& k = mesh.tets[static_cast<size_t>(t)];
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      std::vector<int> ring =
+          tets_with_edge(state, k[static_cast<size_t>(i)], k[static_cast<size_t>(j)]);
+      if (ring.size() >= 3 && ring.size() <= 10) cavities.push_back(std::move(ring));
+    }
+  return cavities;
+}
+
+}  // namespace stc

@@ -1,0 +1,44 @@
+// Vertex insertion (docs/DESIGN.md section 8, "Insert"; stop 42): where neither smoothing nor a
+// flip raises a thin tet, a new node inside a small cavity around it - the tet and its
+// neighbours across faces on no cut, or the ring of tets around one of its edges - joined to
+// every face of the cavity's boundary. The cavity's boundary faces (skin, cut walls, the faces
+// it shares with the rest of the mesh) stay exactly as they were, so nothing that opened closes
+// and the volume is exact; its corners all stay in the mesh. The new node is interior: the
+// corners of a sliver that may not move (on the curved skin, on several cut planes) no longer
+// need to.
+#pragma once
+
+#include "cutting/cut_state.hpp"
+
+#include <array>
+#include <vector>
+
+namespace stc {
+
+// Stands for the inserted node in VertexInsertion::tets until it is appended.
+inline constexpr int kInsertedNode = -1;
+
+struct VertexInsertion {
+  std::vector<int> cavity;  // ascending
+  std::vector<Tet> tets;    // one per boundary face of the cavity, with kInsertedNode
+  Vec3 point = Vec3::Zero();
+  Tet host{};  // the cavity tet that holds `point` (its displacement is interpolated there)
+  std::array<double, 4> weights{};  // point's barycentric coordinates in `host`
+  double size_class = 0;            // the smallest of the cavity's: the new tets'
+  double before = 0;                // smallest dihedral angle of the cavity's tets
+  double after = 0;                 // of the new ones
+};
+
+// The insertion into `cavity` (tet indices) at the position that maximises the new tets'
+// smallest dihedral angle, if one exists: every cavity tet cuttable, no face inside the cavity
+// on a cut, every corner on its boundary, and every new tet above `guard` of the size class,
+// tiling the cavity (volumes summing to its own to 1e-12) and no flatter by the volume ratio
+// than the cavity's flattest tet.
+bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                      double guard, VertexInsertion& insertion);
+
+// The cavities tried for tet t: t with its neighbours across its faces on no cut, and the ring
+// of each of its edges (3 to 10 tets).
+std::vector<std::vector<int>> insertion_cavities(const TetMesh& mesh, const CutState& state, int t);
+
+}  // namespace stc
