@@ -22,7 +22,8 @@ struct VertexInsertion {
   std::vector<int> cavity;  // ascending
   std::vector<Tet> tets;    // one per boundary face of the cavity, with kInsertedNode
   Vec3 point = Vec3::Zero();
-  Tet host{};  // the cavity tet that holds `point` (its displacement is interpolated there)
+  Tet host{};  // the cavity tet that holds `point` (its displacement is interpolated there,
+               // docs/DESIGN.md eq. (21a))
   std::array<double, 4> weights{};  // point's barycentric coordinates in `host`
   double size_class = 0;            // the smallest of the cavity's: the new tets'
   double before = 0;                // smallest dihedral angle of the cavity's tets

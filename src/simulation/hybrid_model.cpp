@@ -374,7 +374,7 @@ void HybridModel::update_operation_part(const std::vector<int>& changed_tets,
     const int node = old_nodes + k;
     const NewNode& nn = new_nodes[static_cast<size_t>(k)];
     const bool split = nn.kind == NewNode::Kind::kEdgeSplit;
-    if (nn.kind == NewNode::Kind::kInTet) {
+    if (nn.kind == NewNode::Kind::kInTet) {  // docs/DESIGN.md eq. (21a)
       bool fixed = true;
       u_.segment<3>(3 * node).setZero();
       for (int i = 0; i < 4; ++i) {

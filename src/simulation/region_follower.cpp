@@ -191,6 +191,7 @@ void RegionFollower::start(const HybridModel& from, const Vec3& centre, std::vec
         const TetMesh& mesh = r.model->mesh();
         const Partition& p = r.model->partition();
         r.boundary.init(mesh, p.operation_tet);
+        r.surface_tree.build(r.boundary.current(mesh), mesh, p.operation_tet, {});
         r.cuttable = p.operation_tet;
         r.locked.assign(mesh.nodes.size(), 0);
         std::vector<std::uint8_t> condensed(p.operation_tet.size(), 0);

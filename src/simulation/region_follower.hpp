@@ -15,6 +15,7 @@
 #include "cutting/cut_state.hpp"
 #include "cutting/tet_grid.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/collision/surface_bvh.hpp"
 #include "soft_tissue_cutting/simulation/hybrid_model.hpp"
 #include "soft_tissue_cutting/simulation/operation_surface.hpp"
 #include "soft_tissue_cutting/simulation/region_move_stats.hpp"
@@ -32,7 +33,10 @@ namespace stc {
 // partition, so the swap itself only exchanges pointers.
 struct MovedRegion {
   std::unique_ptr<HybridModel> model;
-  OperationSurface boundary;           // the new partition's operation surface
+  OperationSurface boundary;  // the new partition's operation surface
+  // Its collision tree, built on the rest shape (the mesh does not change while a move runs:
+  // the sweeps wait), fitted to the deformation at the swap.
+  SurfaceBvh surface_tree;
   std::vector<std::uint8_t> cuttable;  // per tet: part 1 of the new partition
   std::vector<std::uint8_t> locked;    // per node: a node of a condensed tet
   TetGrid cut_grid;                    // the part-1 tets

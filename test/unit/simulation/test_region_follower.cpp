@@ -12,6 +12,7 @@
 #include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/partition/follow_region.hpp"
 #include "soft_tissue_cutting/scene/scene_loader.hpp"
+#include "soft_tissue_cutting/simulation/operation_surface.hpp"
 
 #include "common/mesh_files.hpp"
 
@@ -447,6 +448,17 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
     swaps += st.region_moved;
     swaps_cutting += st.region_moved && st.cutting;
     cutting_steps += st.cutting;
+    if (st.region_moved) {
+      // The collision tree the worker built is the new partition's operation surface, in its
+      // order (part-2 triangles first), as one extracted afresh on the loop would be.
+      OperationSurface fresh;
+      fresh.init(paced.mesh(), paced.model().partition().operation_tet);
+      const auto expected = fresh.current(paced.mesh()).triangles;
+      const auto taken = paced.surface_snapshot().triangles;
+      ASSERT_EQ(taken.size(), expected.size()) << "step " << st.step;
+      for (size_t i = 0; i < taken.size(); ++i)
+        ASSERT_EQ(taken[i].nodes, expected[i].nodes) << "step " << st.step << ", triangle " << i;
+    }
     // The lag the step reports: the waiting sweeps' travel, each at most this stroke's
     // largest step (1.1 mm: the lift), nothing when none waits.
     EXPECT_GE(st.sweeps_waiting, 0);
