@@ -1,6 +1,7 @@
 #include "common/cut_measures.hpp"
 
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
+#include "soft_tissue_cutting/mesh/quality.hpp"
 
 namespace stc::test {
 
@@ -12,6 +13,14 @@ double open_cut_area(const TetMesh& mesh) {
     area += 0.5 * (mesh.nodes[tri.nodes[1]] - a).cross(mesh.nodes[tri.nodes[2]] - a).norm();
   }
   return area;
+}
+
+int thin_tets(const TetMesh& mesh, double below_deg) {
+  int thin = 0;
+  for (const Tet& e : mesh.tets)
+    thin += smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                                  mesh.nodes[e[3]]) < below_deg;
+  return thin;
 }
 
 int closed_cut_faces(const TetMesh& mesh) {

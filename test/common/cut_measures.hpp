@@ -17,6 +17,9 @@ double open_cut_area(const TetMesh& mesh);
 // Number of cut faces still closed (marked, shared by two tets): a crack front waiting.
 int closed_cut_faces(const TetMesh& mesh);
 
+// Number of tets whose smallest dihedral angle is under `below_deg` degrees.
+int thin_tets(const TetMesh& mesh, double below_deg = 5.0);
+
 // The hybrid matrix without the rows and columns of the DOFs of held nodes (`held_node`: one
 // flag per mesh node; the nodes of free pieces): the block that must stay SPD after a cut.
 SparseMatrix free_block(const HybridModel& model, const std::vector<std::uint8_t>& held_node);

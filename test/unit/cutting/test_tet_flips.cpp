@@ -3,6 +3,7 @@
 // on a TetGen liver after six strokes, both kinds of flip are made and change no boundary face,
 // no cut face and no volume, while the tets under 5 deg become fewer.
 #include "common/cut_fidelity_scenes.hpp"
+#include "common/cut_measures.hpp"
 #include "cutting/cut_state.hpp"
 #include "cutting/cut_sweep.hpp"
 #include "cutting/tet_flips.hpp"
@@ -19,14 +20,6 @@ namespace stc {
 namespace {
 
 double smallest_angle(const TetMesh& mesh) { return mesh_quality(mesh).min_dihedral_deg; }
-
-int thin_tets(const TetMesh& mesh) {
-  int thin = 0;
-  for (const Tet& e : mesh.tets)
-    thin += smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                  mesh.nodes[e[3]]) < 5.0;
-  return thin;
-}
 
 // The boundary's faces and the faces on a cut, each as its sorted corners (a face on a cut
 // that has not opened is listed once per side).
@@ -104,12 +97,12 @@ TEST(TetFlips, AfterStrokesOnATetGenLiverOnlyTheInsideChanges) {
   options.flip_thin_tets = false;  // the strokes smooth but do not flip
   fidelity::crossing_strokes(mesh, state, 6, options);
   const auto stay = faces_that_stay(mesh);
-  const int thin_before = thin_tets(mesh), tets_before = mesh.num_tets();
+  const int thin_before = test::thin_tets(mesh), tets_before = mesh.num_tets();
   std::vector<int> all(static_cast<size_t>(mesh.num_tets()));
   for (int t = 0; t < mesh.num_tets(); ++t) all[static_cast<size_t>(t)] = t;
   CutResult result;
   const FlipCounts flips = flip_thin_tets(mesh, state, CutOptions{}, all, result);
-  const int thin_after = thin_tets(mesh);
+  const int thin_after = test::thin_tets(mesh);
   std::printf(
       "TetGen liver, 6 strokes: %d 2-3 flips, %d edge removals; tets %d -> %d, under 5 deg "
       "%d -> %d\n",

@@ -4,6 +4,7 @@
 // node interior, where its weights in its host put it; a cut face inside a cavity, or a node
 // that the cavity would lose, forbids it.
 #include "common/cut_fidelity_scenes.hpp"
+#include "common/cut_measures.hpp"
 #include "cutting/cut_state.hpp"
 #include "cutting/tet_flips.hpp"
 #include "cutting/triangle_cut.hpp"
@@ -28,14 +29,6 @@ std::multiset<std::array<int, 3>> boundary_faces(const TetMesh& mesh) {
     faces.insert(k);
   }
   return faces;
-}
-
-int thin_tets(const TetMesh& mesh) {
-  int thin = 0;
-  for (const Tet& e : mesh.tets)
-    thin += smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                  mesh.nodes[e[3]]) < 5.0;
-  return thin;
 }
 
 // A TetGen liver after six crossing strokes that smoothed and flipped but inserted nothing.
@@ -66,7 +59,7 @@ TEST(VertexInsertion, WhereFlipsStopNodesInsideRemoveMoreThinTets) {
   StrokedLiver flipped = stroked_liver();
   StrokedLiver inserted = flipped;
   const auto surface = boundary_faces(inserted.mesh);
-  const int thin_before = thin_tets(inserted.mesh), nodes_before = inserted.mesh.num_nodes();
+  const int thin_before = test::thin_tets(inserted.mesh), nodes_before = inserted.mesh.num_nodes();
   CutOptions no_insertion;
   no_insertion.insert_nodes = false;
   CutResult flips_only, with_insertion;
@@ -74,7 +67,8 @@ TEST(VertexInsertion, WhereFlipsStopNodesInsideRemoveMoreThinTets) {
       flip_thin_tets(flipped.mesh, flipped.state, no_insertion, all_tets(flipped.mesh), flips_only);
   const FlipCounts b = flip_thin_tets(inserted.mesh, inserted.state, CutOptions{},
                                       all_tets(inserted.mesh), with_insertion);
-  const int thin_flipped = thin_tets(flipped.mesh), thin_inserted = thin_tets(inserted.mesh);
+  const int thin_flipped = test::thin_tets(flipped.mesh),
+            thin_inserted = test::thin_tets(inserted.mesh);
   std::printf(
       "TetGen liver, 6 strokes, tets under 5 deg %d: flips only %d (%d flips), with insertion "
       "%d (%d flips, %d insertions); tets %d / %d\n",

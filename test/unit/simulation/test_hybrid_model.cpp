@@ -246,6 +246,14 @@ TEST(HybridModel, UpdateOperationPartMatchesFullModelOnNewMesh) {
   EXPECT_THROW(h.update_operation_part({part2}, {}), std::logic_error);
 }
 
+// Solves (asserting convergence) and returns the error of every node against the full model.
+double solved_error_vs_full(HybridModel& h) {
+  EXPECT_TRUE(h.solve().converged);
+  const Reference ref = full_reference(h);
+  h.recover_interior();
+  return nodal_error(h.displacement(), ref.u, all_nodes(h.mesh()));
+}
+
 // A node inserted inside part-1 tet t at barycentric w (the tet becomes four through it, as a
 // vertex insertion's cavity of one tet would): its displacement starts at sum w_k u_k, and the
 // hybrid solution still matches the full model's on the new mesh.
@@ -297,12 +305,7 @@ TEST(HybridModel, ANodeInsertedInATetStartsInterpolatedAndSolvesAsTheFullModel) 
   EXPECT_EQ(h.counts().nodes, before.nodes + 1);
   EXPECT_EQ(h.counts().tets, before.tets + 3);
   EXPECT_EQ(h.counts().dof_operation, before.dof_operation + 3);
-  const CgResult r = h.solve();
-  EXPECT_TRUE(r.converged);
-  const Reference ref = full_reference(h);
-  h.recover_interior();
-  const double e = nodal_error(h.displacement(), ref.u, all_nodes(h.mesh()));
-  EXPECT_LE(e, 1e-9);
+  EXPECT_LE(solved_error_vs_full(h), 1e-9);
   // A corner index past the new node is refused.
   NewNode bad = inserted;
   bad.index = node + 1;
