@@ -275,7 +275,7 @@ class SweptSurface {
 // of its boundary faces go to the new tets that have those faces (the faces inside were on no
 // cut). Returns the new tets' indices.
 std::vector<int> apply(TetMesh& mesh, CutState& state, Flip flip, CutResult& result) {
-  if (flip.insert) {  // the new node first, its displacement interpolated in `host` (eq. (21))
+  if (flip.insert) {  // the new node first, its displacement interpolated in `host` (eq. (21a))
     NewNode node;
     node.index = mesh.num_nodes();
     node.kind = NewNode::Kind::kInTet;
