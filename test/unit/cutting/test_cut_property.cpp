@@ -378,7 +378,7 @@ TEST(CutProperty, QualityAfter100Cuts) {
   std::array<int, 3> thin = {0, 0, 0};
   for (const auto& [specimen, min_ratio] :
        {std::make_pair(thigh_specimen(), 0.0008), std::make_pair(box_specimen(), 0.0012),
-        std::make_pair(liver_specimen(), 0.0005)}) {
+        std::make_pair(liver_specimen(), 0.0008)}) {
     const std::array<int, 3> here = report_quality_after_100_cuts(specimen, 0.2, min_ratio);
     for (size_t m = 0; m < 3; ++m) thin[m] += here[m];
   }
@@ -387,12 +387,11 @@ TEST(CutProperty, QualityAfter100Cuts) {
   EXPECT_LE(thin[1], 0.75 * thin[0]) << "the smoothing removes at least a quarter of the thin tets";
   // Stop 39 (flips, cutting/tet_flips.hpp): 1235 -> 939 (-24 %; thigh 497 -> 381, box 421 ->
   // 291, liver 317 -> 267). Asserted over the twelve runs: at least 15 % fewer.
-  // Stop 42 (vertex insertion among the flips, cutting/vertex_insertion.hpp): 939 -> 914
-  // (thigh 381 -> 309, box 291 -> 289, liver 267 -> 316: each run's cut sequence changes, and
-  // on these single sweeps the insertion's gain is within the scatter; on the sagging TetGen
-  // liver's strokes it is -28 %, TetGenLiverInsertionLeavesFewerThinTets). The Gmsh liver's
-  // seed 2 then ends with a volume ratio of 0.0007 (from 0.0013-0.0028 in its other runs), so
-  // its threshold is 0.0005.
+  // Stop 42 (vertex insertion among the flips, cutting/vertex_insertion.hpp; off by default,
+  // measured with it on): 939 -> 914 (thigh 381 -> 309, box 291 -> 289, liver 267 -> 316: each
+  // run's cut sequence changes, and on these single sweeps the gain is within the scatter; on
+  // the sagging TetGen liver's strokes it is -28 %, TetGenLiverInsertionLeavesFewerThinTets),
+  // and the Gmsh liver's seed 2 then ends with a volume ratio of 0.0007.
   EXPECT_LE(thin[2], 0.85 * thin[1]) << "the flips remove at least 15 % of what the smoothing left";
 }
 

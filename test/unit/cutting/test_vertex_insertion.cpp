@@ -60,12 +60,13 @@ TEST(VertexInsertion, WhereFlipsStopNodesInsideRemoveMoreThinTets) {
   StrokedLiver inserted = flipped;
   const auto surface = boundary_faces(inserted.mesh);
   const int thin_before = test::thin_tets(inserted.mesh), nodes_before = inserted.mesh.num_nodes();
-  CutOptions no_insertion;
+  CutOptions no_insertion, insertion_on;
   no_insertion.insert_nodes = false;
+  insertion_on.insert_nodes = true;
   CutResult flips_only, with_insertion;
   const FlipCounts a =
       flip_thin_tets(flipped.mesh, flipped.state, no_insertion, all_tets(flipped.mesh), flips_only);
-  const FlipCounts b = flip_thin_tets(inserted.mesh, inserted.state, CutOptions{},
+  const FlipCounts b = flip_thin_tets(inserted.mesh, inserted.state, insertion_on,
                                       all_tets(inserted.mesh), with_insertion);
   const int thin_flipped = test::thin_tets(flipped.mesh),
             thin_inserted = test::thin_tets(inserted.mesh);

@@ -274,12 +274,11 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   EXPECT_LE(*std::max_element(iterations.begin(), iterations.end()),
             2 * std::max(cold_iterations, 1));
   // Shapes (not met: >= 5 deg asked; the input itself starts at 1.9 deg): regression guards
-  // with margin over what stop 42 measures after 100 strokes with the vertex insertion (109
-  // tets under 5 deg, 77 of them in the operation part, min 0.72 deg; 136-139 with variants of
-  // its ascent that change the cut sequence; stop 39's flips 171 / 0.55, stop 38's smoothing
-  // alone 241 / 0.42, stop 37's 261 / 0.55).
+  // with margin over what stop 39 measures after 100 strokes with the flips (171 tets under 5
+  // deg, min 0.55 deg; stop 38's smoothing alone 241 / 0.42, stop 37's 261 / 0.55; stop 42's
+  // vertex insertion, off by default, 109 / 0.72: TetGenLiverInsertionLeavesFewerThinTets).
   if (strokes >= 100) {
-    EXPECT_LE(thin_at_100, 165) << "tets under 5 deg after 100 strokes";
+    EXPECT_LE(thin_at_100, 210) << "tets under 5 deg after 100 strokes";
     EXPECT_GT(dihedral_at_100, 0.3) << "min dihedral after 100 strokes";
   }
   // The upkeep is counted where the run reports (stats JSON, ModelCounts): each stroke that
