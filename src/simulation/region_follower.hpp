@@ -35,7 +35,7 @@ struct MovedRegion {
   std::unique_ptr<HybridModel> model;
   OperationSurface boundary;  // the new partition's operation surface
   // Its collision tree, built on the rest shape (the mesh does not change while a move runs:
-  // the sweeps wait), fitted to the deformation at the swap.
+  // the sweeps wait); its readers refit it to the deformation before each query.
   SurfaceBvh surface_tree;
   std::vector<std::uint8_t> cuttable;  // per tet: part 1 of the new partition
   std::vector<std::uint8_t> locked;    // per node: a node of a condensed tet

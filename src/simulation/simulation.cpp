@@ -611,10 +611,9 @@ struct Simulation::Impl {
     pass_held_nodes_to_model();  // the worker's set: no refactorization
     recompute_anchors();
     // The worker built the new partition's collision tree (on the rest shape; ~4.5 ms of a swap
-    // step at organ scale when built here): fitted to the deformation now, and the old tree
-    // freed with the old model off the loop.
+    // step at organ scale when built here): taken as it is - every reader of the tree refits it
+    // to the deformation first - and the old tree freed with the old model off the loop.
     std::swap(surface_tree, moved->surface_tree);
-    surface_tree.refit(model->mesh(), displacements());
     surface_tree_extraction = boundary.extraction();
     retire(std::move(replaced), std::move(*moved));
     s.region_moved = true;
