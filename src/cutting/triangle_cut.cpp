@@ -55,10 +55,11 @@ struct Split {
   double t;  // crossing at x_a + t (x_b - x_a)
 };
 
-// Volume of the smallest piece tet `nodes` falls into when the crossing edges in `splits`
-// are bisected in that order (the order split_along_triangle applies them in). Each piece
+// The pieces (corner positions) tet `nodes` falls into when the crossing edges in `splits` are
+// bisected in that order (the order split_along_triangle applies them in). Each piece
 // containing an edge being split is bisected, exactly as bisect_edge does.
-double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
+std::vector<std::array<Vec3, 4>> pieces_of(const TetMesh& mesh, const Tet& nodes,
+                                           const std::vector<Split>& splits) {
   struct Piece {
     std::array<int, 4> id;
     std::array<Vec3, 4> x;
@@ -85,9 +86,17 @@ double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<S
       pieces.push_back(other);
     }
   }
+  std::vector<std::array<Vec3, 4>> out;
+  out.reserve(pieces.size());
+  for (const Piece& p : pieces) out.push_back(p.x);
+  return out;
+}
+
+// Volume of the smallest of those pieces.
+double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
   double smallest = 1e300;
-  for (const Piece& p : pieces)
-    smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
+  for (const auto& x : pieces_of(mesh, nodes, splits))
+    smallest = std::min(smallest, signed_volume(x[0], x[1], x[2], x[3]));
   return smallest;
 }
 
@@ -107,12 +116,28 @@ std::vector<Split> splits_of(const Tet& nodes,
   return splits;
 }
 
+// The shape guard (CutOptions::split_min_dihedral_deg, docs/DESIGN.md section 8 "Shape
+// guard"): would bisecting `splits` leave a piece of tet `nodes` with a smallest dihedral angle
+// under the limit, or under the tet's own where that is less (a thin tet may still be cut, but
+// never into something thinner than itself)?
+bool too_flat(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits,
+              const CutOptions& options) {
+  if (!(options.split_min_dihedral_deg > 0)) return false;
+  const double own = smallest_dihedral_deg(mesh.nodes[nodes[0]], mesh.nodes[nodes[1]],
+                                           mesh.nodes[nodes[2]], mesh.nodes[nodes[3]]);
+  const double limit = std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
+  for (const auto& x : pieces_of(mesh, nodes, splits))
+    if (smallest_dihedral_deg(x[0], x[1], x[2], x[3]) < limit) return true;
+  return false;
+}
+
 // The volume guard: would bisecting `splits` leave a piece of tet t under min_volume_fraction
-// of the tet it descends from?
+// of the tet it descends from? With the shape guard on, a piece too flat counts as too thin.
 bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vector<Split>& splits,
               const CutOptions& options) {
   return !(smallest_piece(mesh, mesh.tets[t], splits) >=
-           options.min_volume_fraction * state.origin_volume[t]);
+           options.min_volume_fraction * state.origin_volume[t]) ||
+         too_flat(mesh, mesh.tets[t], splits, options);
 }
 
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no
@@ -485,8 +510,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   for (const auto& [edge, t] : crossing) {
     bool fits = true;
     for (int k : tets_with_edge(state, edge.first, edge.second))
-      fits = fits && smallest_piece(mesh, mesh.tets[k], {Split{edge.first, edge.second, t}}) >=
-                         options.min_volume_fraction * state.origin_volume[k];
+      fits = fits && !too_thin(mesh, state, k, {Split{edge.first, edge.second, t}}, options);
     if (!fits) continue;
     const size_t before = result.changed_tets.size();
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);
