@@ -317,11 +317,18 @@ class SceneLoader {
   }
 
   void load_scalpel(const YAML::Node& n) {
-    f_.check_map(n, "scalpel", {"blade_length", "cut_pressure"});
+    f_.check_map(n, "scalpel", {"blade_length", "cut_pressure", "shape_guard_deg"});
     if (n["blade_length"])
       scene_.scalpel.blade_length = f_.positive(n["blade_length"], "scalpel.blade_length");
     if (n["cut_pressure"])
       scene_.scalpel.cut_pressure = f_.non_negative(n["cut_pressure"], "scalpel.cut_pressure");
+    if (n["shape_guard_deg"]) {
+      // Above 30 deg most splits of a good mesh would be refused (a regular tet's angles are
+      // 70.5 deg, and a bisection halves some of them): the cut would no longer follow the blade.
+      const double deg = f_.non_negative(n["shape_guard_deg"], "scalpel.shape_guard_deg");
+      if (deg > 30) f_.fail(n["shape_guard_deg"], "scalpel.shape_guard_deg", "must be <= 30 (degrees)");
+      scene_.scalpel.shape_guard_deg = deg;
+    }
   }
 
   void load_trajectory(const YAML::Node& list) {

@@ -62,6 +62,10 @@ struct OperationRegion {
 struct ScalpelParams {
   double blade_length = 0.02;  // m, edge from the tip along local +x
   double cut_pressure = 0.5;   // N
+  // Degrees; 0: off. The cutter's shape guard (CutOptions::split_min_dihedral_deg): no cut
+  // makes a tet thinner than this or than the one it splits, at the cost of following the
+  // blade less closely (docs/DESIGN.md section 8, "Shape guard"). Extension of this package.
+  double shape_guard_deg = 0;
 };
 
 // A blade pose in the scene frame: origin = blade tip, local +x = cutting edge, local y =

@@ -80,6 +80,12 @@ TEST(SceneLoader, DefaultsAndScaleBeforeSelectors) {
   EXPECT_EQ(s.solver.backend, Backend::kCpu);
   EXPECT_DOUBLE_EQ(s.material.young_modulus, 3000.0);
   EXPECT_TRUE(s.trajectory.empty());
+  EXPECT_EQ(s.scalpel.shape_guard_deg, 0.0);  // off unless asked for
+  const std::string guarded = write_file(dir.file("g.yaml"),
+                                         "mesh: {file: box.msh}\n"
+                                         "fixed: [{nodes: [0]}]\n"
+                                         "scalpel: {shape_guard_deg: 5}\n");
+  EXPECT_DOUBLE_EQ(load_scene(guarded).scalpel.shape_guard_deg, 5.0);
 }
 
 TEST(SceneLoader, QuaternionIsNormalizedAndFlippedMeshWarns) {
@@ -239,6 +245,12 @@ INSTANTIATE_TEST_SUITE_P(
                        3, "> 0"},
         SceneErrorCase{"cut_pressure_negative", "scalpel: {cut_pressure: -0.1}\n",
                        "scalpel.cut_pressure", 3, ">= 0"},
+        SceneErrorCase{"shape_guard_negative", "scalpel: {shape_guard_deg: -1}\n",
+                       "scalpel.shape_guard_deg", 3, ">= 0"},
+        SceneErrorCase{"shape_guard_too_large", "scalpel: {shape_guard_deg: 45}\n",
+                       "scalpel.shape_guard_deg", 3, "<= 30"},
+        SceneErrorCase{"shape_guard_word", "scalpel: {shape_guard_deg: strict}\n",
+                       "scalpel.shape_guard_deg", 3, "number"},
         SceneErrorCase{
             "trajectory_time_order",
             "trajectory:\n  - {t: 0.5, position: [0, 0, 0]}\n  - {t: 0.5, position: [0, 0, 1]}\n",

@@ -350,9 +350,14 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   const Scene scene = fidelity::sagging_liver();
   const Vec3 centre = scene.operation_region.sphere.center;
   for (unsigned seed : {1u, 2u}) {
+    // Seed 1 through the cutter's options, seed 2 through the scene's key (docs/SCENE.md).
     SimulationOptions options;
-    options.cut.split_min_dihedral_deg = 5;
-    Simulation sim(scene, options);
+    Scene guarded = scene;
+    if (seed == 1)
+      options.cut.split_min_dihedral_deg = 5;
+    else
+      guarded.scalpel.shape_guard_deg = 5;
+    Simulation sim(guarded, options);
     const double floor = std::min(5.0, operation_min_dihedral(sim)) - 1e-6;
     const int cold_iterations = std::max(sim.last_stats().cg_iterations, 1);
     std::mt19937 rng(seed);
