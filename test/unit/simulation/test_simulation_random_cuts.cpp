@@ -198,20 +198,28 @@ std::vector<BladePose> random_liver_stroke(std::mt19937& rng, const Vec3& centre
   return {a, b};
 }
 
-// Tets of the operation part under 5 deg (the condensed part is never cut: its thin tets are
-// the input's).
-int thin_operation_tets(const Simulation& sim) {
+// The operation part's shapes (the condensed part is never cut: its thin tets are the
+// input's): its smallest dihedral angle and how many of its tets are under 5 deg.
+struct OperationShape {
+  double least = 180;
   int thin = 0;
+};
+OperationShape operation_shape(const Simulation& sim) {
+  OperationShape out;
   const TetMesh& mesh = sim.mesh();
   const auto& operation = sim.model().partition().operation_tet;
   for (int t = 0; t < mesh.num_tets(); ++t) {
+    if (!operation[static_cast<size_t>(t)]) continue;
     const Tet& e = mesh.tets[static_cast<size_t>(t)];
-    thin += operation[static_cast<size_t>(t)] &&
-            smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                  mesh.nodes[e[3]]) < 5.0;
+    const double angle = smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                                               mesh.nodes[e[3]]);
+    out.least = std::min(out.least, angle);
+    out.thin += angle < 5.0;
   }
-  return thin;
+  return out;
 }
+int thin_operation_tets(const Simulation& sim) { return operation_shape(sim).thin; }
+double operation_min_dihedral(const Simulation& sim) { return operation_shape(sim).least; }
 
 TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
   const int strokes = stroke_count(300);
@@ -323,20 +331,6 @@ TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
       "TetGen liver, 4 x 100 strokes: operation tets under 5 deg %d without insertion, %d with\n",
       thin[0], thin[1]);
   EXPECT_LE(thin[1], 0.85 * thin[0]);
-}
-
-// The smallest dihedral angle of the operation part (the cutter's tets).
-double operation_min_dihedral(const Simulation& sim) {
-  double least = 180;
-  const TetMesh& mesh = sim.mesh();
-  const auto& operation = sim.model().partition().operation_tet;
-  for (int t = 0; t < mesh.num_tets(); ++t) {
-    const Tet& e = mesh.tets[static_cast<size_t>(t)];
-    if (operation[static_cast<size_t>(t)])
-      least = std::min(least, smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]],
-                                                    mesh.nodes[e[2]], mesh.nodes[e[3]]));
-  }
-  return least;
 }
 
 // Issue 9 item 4 with the shape guard on (CutOptions::split_min_dihedral_deg = 5, docs/DESIGN.md
