@@ -55,15 +55,17 @@ struct Split {
   double t;  // crossing at x_a + t (x_b - x_a)
 };
 
-// The pieces (corner positions) tet `nodes` falls into when the crossing edges in `splits` are
-// bisected in that order (the order split_along_triangle applies them in). Each piece
-// containing an edge being split is bisected, exactly as bisect_edge does.
-std::vector<std::array<Vec3, 4>> pieces_of(const TetMesh& mesh, const Tet& nodes,
-                                           const std::vector<Split>& splits) {
-  struct Piece {
-    std::array<int, 4> id;
-    std::array<Vec3, 4> x;
-  };
+// A piece of a tet being bisected: its corners (negative ids: crossing points not made yet).
+struct Piece {
+  std::array<int, 4> id;
+  std::array<Vec3, 4> x;
+};
+
+// The pieces tet `nodes` falls into when the crossing edges in `splits` are bisected in that
+// order (the order split_along_triangle applies them in). Each piece containing an edge being
+// split is bisected, exactly as bisect_edge does.
+std::vector<Piece> pieces_of(const TetMesh& mesh, const Tet& nodes,
+                             const std::vector<Split>& splits) {
   std::vector<Piece> pieces(1);
   for (int k = 0; k < 4; ++k) {
     pieces[0].id[k] = nodes[k];
@@ -86,17 +88,14 @@ std::vector<std::array<Vec3, 4>> pieces_of(const TetMesh& mesh, const Tet& nodes
       pieces.push_back(other);
     }
   }
-  std::vector<std::array<Vec3, 4>> out;
-  out.reserve(pieces.size());
-  for (const Piece& p : pieces) out.push_back(p.x);
-  return out;
+  return pieces;
 }
 
 // Volume of the smallest of those pieces.
 double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
   double smallest = 1e300;
-  for (const auto& x : pieces_of(mesh, nodes, splits))
-    smallest = std::min(smallest, signed_volume(x[0], x[1], x[2], x[3]));
+  for (const Piece& p : pieces_of(mesh, nodes, splits))
+    smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
   return smallest;
 }
 
@@ -126,8 +125,8 @@ bool too_flat(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& s
   const double own = smallest_dihedral_deg(mesh.nodes[nodes[0]], mesh.nodes[nodes[1]],
                                            mesh.nodes[nodes[2]], mesh.nodes[nodes[3]]);
   const double limit = std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
-  for (const auto& x : pieces_of(mesh, nodes, splits))
-    if (smallest_dihedral_deg(x[0], x[1], x[2], x[3]) < limit) return true;
+  for (const Piece& p : pieces_of(mesh, nodes, splits))
+    if (smallest_dihedral_deg(p.x[0], p.x[1], p.x[2], p.x[3]) < limit) return true;
   return false;
 }
 
