@@ -122,12 +122,14 @@ std::vector<Split> splits_of(const Tet& nodes,
 bool too_flat(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits,
               const CutOptions& options) {
   if (!(options.split_min_dihedral_deg > 0)) return false;
+  double thinnest = 180;
+  for (const Piece& p : pieces_of(mesh, nodes, splits))
+    thinnest = std::min(thinnest, smallest_dihedral_deg(p.x[0], p.x[1], p.x[2], p.x[3]));
+  if (thinnest >= options.split_min_dihedral_deg - kAngleRoundOffDeg) return false;
+  // Only now the tet's own angle (most splits pass above without it).
   const double own = smallest_dihedral_deg(mesh.nodes[nodes[0]], mesh.nodes[nodes[1]],
                                            mesh.nodes[nodes[2]], mesh.nodes[nodes[3]]);
-  const double limit = std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
-  for (const Piece& p : pieces_of(mesh, nodes, splits))
-    if (smallest_dihedral_deg(p.x[0], p.x[1], p.x[2], p.x[3]) < limit) return true;
-  return false;
+  return thinnest < std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
 }
 
 // The volume guard: would bisecting `splits` leave a piece of tet t under min_volume_fraction
