@@ -91,14 +91,6 @@ std::vector<Piece> pieces_of(const TetMesh& mesh, const Tet& nodes,
   return pieces;
 }
 
-// Volume of the smallest of those pieces.
-double smallest_piece(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits) {
-  double smallest = 1e300;
-  for (const Piece& p : pieces_of(mesh, nodes, splits))
-    smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
-  return smallest;
-}
-
 // The crossings of `crossing` on tet `nodes`' edges, ordered by edge (the order
 // split_along_triangle bisects them in).
 std::vector<Split> splits_of(const Tet& nodes,
@@ -115,30 +107,28 @@ std::vector<Split> splits_of(const Tet& nodes,
   return splits;
 }
 
-// The shape guard (CutOptions::split_min_dihedral_deg, docs/DESIGN.md section 8 "Shape
-// guard"): would bisecting `splits` leave a piece of tet `nodes` with a smallest dihedral angle
-// under the limit, or under the tet's own where that is less (a thin tet may still be cut, but
-// never into something thinner than itself)?
-bool too_flat(const TetMesh& mesh, const Tet& nodes, const std::vector<Split>& splits,
+// The guards on a split: would bisecting `splits` leave a piece of tet t under
+// min_volume_fraction of the tet it descends from (the volume guard), or - with the shape guard
+// on (CutOptions::split_min_dihedral_deg, docs/DESIGN.md section 8 "Shape guard", eq. (20c)) - a
+// piece whose smallest dihedral angle is under the limit, or under the tet's own where that is
+// less (a thin tet may still be cut, never into something thinner than itself)?
+bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vector<Split>& splits,
               const CutOptions& options) {
+  const Tet& nodes = mesh.tets[t];
+  const std::vector<Piece> pieces = pieces_of(mesh, nodes, splits);
+  double smallest = 1e300;
+  for (const Piece& p : pieces)
+    smallest = std::min(smallest, signed_volume(p.x[0], p.x[1], p.x[2], p.x[3]));
+  if (!(smallest >= options.min_volume_fraction * state.origin_volume[t])) return true;
   if (!(options.split_min_dihedral_deg > 0)) return false;
   double thinnest = 180;
-  for (const Piece& p : pieces_of(mesh, nodes, splits))
+  for (const Piece& p : pieces)
     thinnest = std::min(thinnest, smallest_dihedral_deg(p.x[0], p.x[1], p.x[2], p.x[3]));
   if (thinnest >= options.split_min_dihedral_deg - kAngleRoundOffDeg) return false;
   // Only now the tet's own angle (most splits pass above without it).
   const double own = smallest_dihedral_deg(mesh.nodes[nodes[0]], mesh.nodes[nodes[1]],
                                            mesh.nodes[nodes[2]], mesh.nodes[nodes[3]]);
   return thinnest < std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
-}
-
-// The volume guard: would bisecting `splits` leave a piece of tet t under min_volume_fraction
-// of the tet it descends from? With the shape guard on, a piece too flat counts as too thin.
-bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vector<Split>& splits,
-              const CutOptions& options) {
-  return !(smallest_piece(mesh, mesh.tets[t], splits) >=
-           options.min_volume_fraction * state.origin_volume[t]) ||
-         too_flat(mesh, mesh.tets[t], splits, options);
 }
 
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no

@@ -3,6 +3,8 @@
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
+#include <algorithm>
+
 namespace stc::test {
 
 double open_cut_area(const TetMesh& mesh) {
@@ -15,12 +17,22 @@ double open_cut_area(const TetMesh& mesh) {
   return area;
 }
 
+TetShapes tet_shapes(const TetMesh& mesh, const std::vector<std::uint8_t>& selected,
+                     double below_deg) {
+  TetShapes out;
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    if (!selected.empty() && !selected[static_cast<size_t>(t)]) continue;
+    const Tet& e = mesh.tets[static_cast<size_t>(t)];
+    const double angle = smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
+                                               mesh.nodes[e[3]]);
+    out.least = std::min(out.least, angle);
+    out.thin += angle < below_deg;
+  }
+  return out;
+}
+
 int thin_tets(const TetMesh& mesh, double below_deg) {
-  int thin = 0;
-  for (const Tet& e : mesh.tets)
-    thin += smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                  mesh.nodes[e[3]]) < below_deg;
-  return thin;
+  return tet_shapes(mesh, {}, below_deg).thin;
 }
 
 int closed_cut_faces(const TetMesh& mesh) {

@@ -20,6 +20,15 @@ int closed_cut_faces(const TetMesh& mesh);
 // Number of tets whose smallest dihedral angle is under `below_deg` degrees.
 int thin_tets(const TetMesh& mesh, double below_deg = 5.0);
 
+// The shapes of the tets `selected` flags (per tet; empty: all): their smallest dihedral angle
+// and how many lie under `below_deg` degrees.
+struct TetShapes {
+  double least = 180;
+  int thin = 0;
+};
+TetShapes tet_shapes(const TetMesh& mesh, const std::vector<std::uint8_t>& selected = {},
+                     double below_deg = 5.0);
+
 // The hybrid matrix without the rows and columns of the DOFs of held nodes (`held_node`: one
 // flag per mesh node; the nodes of free pieces): the block that must stay SPD after a cut.
 SparseMatrix free_block(const HybridModel& model, const std::vector<std::uint8_t>& held_node);

@@ -262,14 +262,7 @@ TEST(CutFidelity, LiverBoundaryFine) { measure_matrix("liver-50000"); }
 
 // The smallest dihedral angle of the cuttable tets (the operation part less its interface layer).
 double cuttable_min_dihedral(const Bench& b) {
-  double least = 180;
-  for (int t = 0; t < b.mesh.num_tets(); ++t) {
-    if (!b.state.cuttable[static_cast<size_t>(t)]) continue;
-    const Tet& e = b.mesh.tets[static_cast<size_t>(t)];
-    least = std::min(least, smallest_dihedral_deg(b.mesh.nodes[e[0]], b.mesh.nodes[e[1]],
-                                                  b.mesh.nodes[e[2]], b.mesh.nodes[e[3]]));
-  }
-  return least;
+  return test::tet_shapes(b.mesh, b.state.cuttable).least;
 }
 
 // The shape guard on one stroke (cheap enough for the sanitized CI run): the coarse liver2's

@@ -198,25 +198,9 @@ std::vector<BladePose> random_liver_stroke(std::mt19937& rng, const Vec3& centre
   return {a, b};
 }
 
-// The operation part's shapes (the condensed part is never cut: its thin tets are the
-// input's): its smallest dihedral angle and how many of its tets are under 5 deg.
-struct OperationShape {
-  double least = 180;
-  int thin = 0;
-};
-OperationShape operation_shape(const Simulation& sim) {
-  OperationShape out;
-  const TetMesh& mesh = sim.mesh();
-  const auto& operation = sim.model().partition().operation_tet;
-  for (int t = 0; t < mesh.num_tets(); ++t) {
-    if (!operation[static_cast<size_t>(t)]) continue;
-    const Tet& e = mesh.tets[static_cast<size_t>(t)];
-    const double angle = smallest_dihedral_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]],
-                                               mesh.nodes[e[3]]);
-    out.least = std::min(out.least, angle);
-    out.thin += angle < 5.0;
-  }
-  return out;
+// The operation part's shapes (the condensed part is never cut: its thin tets are the input's).
+test::TetShapes operation_shape(const Simulation& sim) {
+  return test::tet_shapes(sim.mesh(), sim.model().partition().operation_tet);
 }
 int thin_operation_tets(const Simulation& sim) { return operation_shape(sim).thin; }
 double operation_min_dihedral(const Simulation& sim) { return operation_shape(sim).least; }
