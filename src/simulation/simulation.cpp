@@ -921,9 +921,9 @@ struct Simulation::Impl {
 Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl) {
   impl_->initial = std::move(scene);
   impl_->options = std::move(options);
-  // The scene's shape guard, unless the caller set the cutter's own (docs/SCENE.md).
-  if (!(impl_->options.cut.split_min_dihedral_deg > 0))
-    impl_->options.cut.split_min_dihedral_deg = impl_->initial.scalpel.shape_guard_deg;
+  // The scene decides the shape guard (docs/SCENE.md, scalpel.shape_guard_deg): one place to
+  // set it, whether the scene came from a file or was built in code.
+  impl_->options.cut.split_min_dihedral_deg = impl_->initial.scalpel.shape_guard_deg;
   impl_->start();
   // Correct either way (solve/blas_guard.hpp), but slower when moves or the display thread
   // factor beside the loop: say so once.

@@ -53,7 +53,8 @@ struct SimulationOptions {
   // loop never waits for it (the solutions differ by rounding only).
   bool wait_for_factor_ahead = false;
   // The cutter's options (docs/DESIGN.md section 8); the defaults are what it describes. Tests
-  // switch a stage off to measure what it does (e.g. insert_nodes).
+  // switch a stage off to measure what it does (e.g. insert_nodes). Except the shape guard
+  // (split_min_dihedral_deg): the scene sets it (ScalpelParams::shape_guard_deg).
   CutOptions cut;
 };
 

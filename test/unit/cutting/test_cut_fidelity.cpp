@@ -201,12 +201,15 @@ Stroke variant(Stroke s, double tilt, double step, bool curved) {
 // The matrix of issue 9 item 1 on one mesh; each stroke on a fresh copy. Asserted here: the cut
 // invariants and floors well under what every configuration measures (a regression guard); the
 // issue's own targets are asserted where they are met (IssueTargets below) - README lists the rest.
+// Every stroke keeps the shape guard's promise (the default 1 deg included); a guard above the
+// default is measured against floors of its own.
 void measure_matrix(const std::string& mesh_name, const CutOptions& options = {}) {
+  const bool strong_guard = options.split_min_dihedral_deg > CutOptions{}.split_min_dihedral_deg;
   for (bool curved : {false, true})
     for (double tilt : {0.0, 45.0})
       for (double step : {0.2e-3, 3e-3}) {
         std::ostringstream label;
-        if (options.split_min_dihedral_deg > 0) label << "shape guard ";
+        if (strong_guard) label << "shape guard ";
         label << (curved ? "curved" : "straight") << " tilt " << tilt << " step " << step * 1e3
               << " mm";
         if (const char* only = std::getenv("STC_FIDELITY_ONLY"))
@@ -215,12 +218,13 @@ void measure_matrix(const std::string& mesh_name, const CutOptions& options = {}
         b->options = options;
         const Figures fig = run_stroke(*b, variant(b->stroke, tilt, step, curved), label.str());
         EXPECT_TRUE(fig.violated.empty()) << fig.line << ": " << fig.violated.front();
-        if (options.split_min_dihedral_deg > 0) {
-          // The shape guard's promise, and floors under what it measures (docs/DESIGN.md
-          // section 8, "Shape guard"): the cut costs fidelity where it would have made a sliver.
-          EXPECT_GE(fig.min_dihedral,
-                    std::min(options.split_min_dihedral_deg, fig.min_dihedral_before) - 1e-6)
-              << fig.line;
+        // The shape guard's promise (docs/DESIGN.md section 8, "Shape guard").
+        EXPECT_GE(fig.min_dihedral,
+                  std::min(options.split_min_dihedral_deg, fig.min_dihedral_before) - 1e-6)
+            << fig.line;
+        if (strong_guard) {
+          // Floors under what a strong guard measures: the cut costs fidelity where it would
+          // have made a sliver.
           EXPECT_GE(fig.f.opening(), 0.85) << fig.line;
           EXPECT_GE(fig.f.covered_area, 0.95 * fig.f.swept_area) << fig.line;
           EXPECT_LE(fig.f.hausdorff_over_tolerance, 3.0) << fig.line;

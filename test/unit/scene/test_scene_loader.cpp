@@ -80,12 +80,17 @@ TEST(SceneLoader, DefaultsAndScaleBeforeSelectors) {
   EXPECT_EQ(s.solver.backend, Backend::kCpu);
   EXPECT_DOUBLE_EQ(s.material.young_modulus, 3000.0);
   EXPECT_TRUE(s.trajectory.empty());
-  EXPECT_EQ(s.scalpel.shape_guard_deg, 0.0);  // off unless asked for
+  EXPECT_EQ(s.scalpel.shape_guard_deg, 1.0);  // the default (docs/SCENE.md)
   const std::string guarded = write_file(dir.file("g.yaml"),
                                          "mesh: {file: box.msh}\n"
                                          "fixed: [{nodes: [0]}]\n"
                                          "scalpel: {shape_guard_deg: 5}\n");
   EXPECT_DOUBLE_EQ(load_scene(guarded).scalpel.shape_guard_deg, 5.0);
+  const std::string unguarded = write_file(dir.file("u.yaml"),
+                                           "mesh: {file: box.msh}\n"
+                                           "fixed: [{nodes: [0]}]\n"
+                                           "scalpel: {shape_guard_deg: 0}\n");
+  EXPECT_EQ(load_scene(unguarded).scalpel.shape_guard_deg, 0.0);  // 0 turns it off
 }
 
 TEST(SceneLoader, QuaternionIsNormalizedAndFlippedMeshWarns) {

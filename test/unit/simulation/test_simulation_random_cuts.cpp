@@ -287,7 +287,9 @@ TEST(SimulationRandomCuts, TetGenLiverStrokesKeepSpec6) {
 // it. Measured (stop 42), tets of the operation part under 5 deg: seeds 1-4 without 152 / 136 /
 // 124 / 171, with 136 / 70 / 104 / 109 (-29 % in all; seeds 5, 6 and 20261123: 157 -> 106,
 // 204 -> 126, 139 -> 77); the smallest angle scatters with the cut sequence either way
-// (0.31-1.19 deg with, 0.55-1.02 without). Asserted: at least 15 % fewer over the four seeds.
+// (0.31-1.19 deg with, 0.55-1.02 without). Stop 44, with the default 1 deg shape guard (which
+// alone takes the four seeds' 583 to 492): 136 / 94 / 121 / 141 without, 125 / 96 / 93 / 105
+// with (-15 %). Asserted: at least 10 % fewer over the four seeds.
 TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
   const Scene scene = fidelity::sagging_liver();
   const Vec3 centre = scene.operation_region.sphere.center;
@@ -314,27 +316,26 @@ TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
   std::printf(
       "TetGen liver, 4 x 100 strokes: operation tets under 5 deg %d without insertion, %d with\n",
       thin[0], thin[1]);
-  EXPECT_LE(thin[1], 0.85 * thin[0]);
+  EXPECT_LE(thin[1], 0.9 * thin[0]);
 }
 
-// Issue 9 item 4 with the shape guard on (CutOptions::split_min_dihedral_deg = 5, docs/DESIGN.md
+// Issue 9 item 4 with the shape guard at 5 deg (scene key scalpel.shape_guard_deg, docs/DESIGN.md
 // section 8 "Shape guard"): after every one of 100 random strokes on the sagging TetGen liver
 // the operation part's smallest dihedral angle stays at least min(5 deg, what it was uncut) -
 // the cutter never makes a tet thinner than 5 deg or than the one it splits - with the cut
 // invariants and every solve converged in at most twice the uncut mesh's CG iterations. The
 // same strokes without it leave 136-152 tets under 5 deg, 0.55-0.68 deg (measured, seeds
-// 20261123, 1, 2; asserted here for seed 1: the guard is what keeps the angle).
+// 20261123, 1, 2; asserted here for seed 1: the guard is what keeps the angle), and with the
+// default 1 deg the angle stays >= 1 deg.
 TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   const Scene scene = fidelity::sagging_liver();
   const Vec3 centre = scene.operation_region.sphere.center;
   for (unsigned seed : {1u, 2u}) {
-    // Seed 1 through the cutter's options, seed 2 through the scene's key (docs/SCENE.md).
+    // The scene decides (docs/SCENE.md): the cutter's own option is overridden by it.
     SimulationOptions options;
+    options.cut.split_min_dihedral_deg = 0;
     Scene guarded = scene;
-    if (seed == 1)
-      options.cut.split_min_dihedral_deg = 5;
-    else
-      guarded.scalpel.shape_guard_deg = 5;
+    guarded.scalpel.shape_guard_deg = 5;
     Simulation sim(guarded, options);
     const double floor = std::min(5.0, operation_min_dihedral(sim)) - 1e-6;
     const int cold_iterations = std::max(sim.last_stats().cg_iterations, 1);
@@ -362,10 +363,9 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   }
   {
     // The built-in thigh (18 deg uncut): 5 deg after 100 random sweeps.
-    const Scene thigh = make_thigh_scene();
-    SimulationOptions options;
-    options.cut.split_min_dihedral_deg = 5;
-    Simulation sim(thigh, options);
+    Scene thigh = make_thigh_scene();
+    thigh.scalpel.shape_guard_deg = 5;
+    Simulation sim(thigh);
     RandomStrokes random(20261122);
     for (int k = 0; k < 100; ++k) {
       sim.cut_along(random.next(thigh.operation_region.sphere.center, 0.02, 0.03, 0.5));
@@ -374,14 +374,24 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
     std::printf("shape guard, thigh: %d tets, operation part min dihedral %.2f deg\n",
                 sim.counts().tets, operation_min_dihedral(sim));
   }
-  // Without it, the same first seed: the thin tets the guard prevents.
-  Simulation plain(scene);
-  std::mt19937 rng(1u);
-  for (int k = 0; k < 100; ++k) plain.cut_along(random_liver_stroke(rng, centre));
-  std::printf("without the guard, seed 1: min dihedral %.2f deg, %d tets under 5 deg\n",
-              operation_min_dihedral(plain), thin_operation_tets(plain));
-  EXPECT_GT(thin_operation_tets(plain), 50);
-  EXPECT_LT(operation_min_dihedral(plain), 2.0);
+  // Without it, and with the default 1 deg, the same first seed: the thin tets a 5 deg guard
+  // prevents, and the floor the default keeps.
+  for (const double guard : {0.0, 1.0}) {
+    Scene plain_scene = scene;
+    plain_scene.scalpel.shape_guard_deg = guard;
+    Simulation plain(plain_scene);
+    std::mt19937 rng(1u);
+    for (int k = 0; k < 100; ++k) plain.cut_along(random_liver_stroke(rng, centre));
+    std::printf("guard %.0f deg, seed 1: min dihedral %.2f deg, %d tets under 5 deg\n", guard,
+                operation_min_dihedral(plain), thin_operation_tets(plain));
+    EXPECT_GT(thin_operation_tets(plain), 50) << "guard " << guard;
+    EXPECT_LT(operation_min_dihedral(plain), 2.0) << "guard " << guard;
+    if (guard > 0) {
+      EXPECT_GE(operation_min_dihedral(plain), guard - 1e-6);
+    } else {
+      EXPECT_LT(operation_min_dihedral(plain), 1.0);
+    }
+  }
 }
 
 // The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k
