@@ -1037,6 +1037,13 @@ double Simulation::cut_path_spacing() const { return impl_->cut_spacing; }
 void Simulation::set_cutting_enabled(bool enabled) { impl_->cutting_enabled = enabled; }
 bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
+void Simulation::set_shape_guard_deg(double degrees) {
+  // The range the scene loader accepts (scalpel.shape_guard_deg, docs/SCENE.md).
+  if (!(degrees >= 0 && degrees <= 30))
+    throw std::invalid_argument("shape_guard_deg must be in [0, 30] degrees");
+  impl_->scene.scalpel.shape_guard_deg = degrees;
+  impl_->options.cut.split_min_dihedral_deg = degrees;
+}
 void Simulation::set_young_modulus(double pascal) {
   if (!(pascal > 0)) throw std::invalid_argument("young_modulus must be > 0");
   impl_->settle_region_move();  // the worker reads the element matrices

@@ -149,6 +149,10 @@ class Simulation {
   void set_cutting_enabled(bool enabled);
   bool cutting_enabled() const;
   void set_cut_pressure(double newtons);
+  // The cutter's shape guard (degrees in [0, 30]; 0: off; docs/DESIGN.md section 8 "Shape
+  // guard"), from the next cut on; scene().scalpel.shape_guard_deg follows it. Throws
+  // std::invalid_argument (and keeps the old value) outside that range.
+  void set_shape_guard_deg(double degrees);
   // Homogeneous material: K scales with E, so K1 and K0 rescale without refactorising.
   void set_young_modulus(double pascal);
 

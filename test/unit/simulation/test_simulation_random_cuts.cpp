@@ -19,10 +19,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 namespace stc {
@@ -331,12 +333,17 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   const Scene scene = fidelity::sagging_liver();
   const Vec3 centre = scene.operation_region.sphere.center;
   for (unsigned seed : {1u, 2u}) {
-    // The scene decides (docs/SCENE.md): the cutter's own option is overridden by it.
+    // Seed 2 through the scene (which decides: the cutter's own option is overridden by it,
+    // docs/SCENE.md), seed 1 set live on an unguarded simulation (dynamic_reconfigure's path).
     SimulationOptions options;
     options.cut.split_min_dihedral_deg = 0;
     Scene guarded = scene;
-    guarded.scalpel.shape_guard_deg = 5;
+    guarded.scalpel.shape_guard_deg = seed == 1 ? 0 : 5;
     Simulation sim(guarded, options);
+    if (seed == 1) {
+      sim.set_shape_guard_deg(5);
+      EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 5.0);
+    }
     const double floor = std::min(5.0, operation_min_dihedral(sim)) - 1e-6;
     const int cold_iterations = std::max(sim.last_stats().cg_iterations, 1);
     std::mt19937 rng(seed);
@@ -392,6 +399,26 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
       EXPECT_LT(operation_min_dihedral(plain), 1.0);
     }
   }
+}
+
+// The live setter (dynamic_reconfigure's shape_guard_deg): values outside [0, 30] degrees, or not
+// a number, are refused with the key named and leave the guard as it was.
+TEST(SimulationRandomCuts, ShapeGuardSetterRefusesOutOfRange) {
+  Simulation sim(make_thigh_scene());
+  EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 1.0);  // the scene's default
+  for (const double bad : {-1.0, 30.5, std::nan("")}) {
+    try {
+      sim.set_shape_guard_deg(bad);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("shape_guard_deg"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 1.0) << "after " << bad;
+  }
+  sim.set_shape_guard_deg(0);
+  EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 0.0);
+  sim.set_shape_guard_deg(30);
+  EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 30.0);
 }
 
 // The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k
