@@ -31,6 +31,10 @@ void TissueNode::remember_backend_locked() {
   backend_ = sim_->backend();
   renderer_ = sim_->renderer();
   backend_note_ = sim_->backend_note();
+  // What the simulation itself uses (after ~reset too), not what the server was told.
+  const Scene& scene = sim_->scene();
+  tuning_ = {scene.scalpel.cut_pressure, scene.material.young_modulus,
+             scene.scalpel.shape_guard_deg};
 }
 
 void TissueNode::remember_solver_failure(const std::string& why) {
@@ -44,6 +48,7 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::optional<RegionMoveStats> moves;
   int sweeps_waiting = 0;
   double cut_lag = 0;
+  Tuning tuning;
   {
     std::lock_guard<std::mutex> lock(info_mutex_);
     backend = backend_;
@@ -55,6 +60,7 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     moves = region_moves_;
     sweeps_waiting = sweeps_waiting_;
     cut_lag = cut_lag_;
+    tuning = tuning_;
   }
   const double period_ms = 1000.0 / params_.rate;
   std::string summary = h.level == LoopHealth::kOk ? h.summary + " on " + backend : h.summary;
@@ -79,6 +85,10 @@ void TissueNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("solved by", solved_by);  // cpu when a gl solve fell back
   status.add("fallback reason", fallback);
   status.add("steps", h.steps);
+  // The live tuning in use (dynamic_reconfigure's values, kept through ~reset).
+  status.add("cut pressure (N)", tuning.cut_pressure);
+  status.add("Young's modulus (Pa)", tuning.young_modulus);
+  status.add("shape guard (deg)", tuning.shape_guard_deg);
   if (moves) {  // `follow` operation region (docs/ROS.md "API")
     std::vector<double> d = moves->durations_ms;
     std::sort(d.begin(), d.end());

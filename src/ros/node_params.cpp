@@ -66,6 +66,11 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
     read(pnh, "cut_pressure", number, "a number (N)");
     read(pnh, "young_modulus", number, "a number (Pa)");
     read(pnh, "cutting_enabled", flag, "true or false");
+    // The range dynamic_reconfigure would clamp to silently, and the scene key's (SCENE.md).
+    number = 0;
+    read(pnh, "shape_guard_deg", number, "a number (degrees)");
+    if (!(number >= 0 && number <= 30))
+      throw std::runtime_error("~shape_guard_deg must be in [0, 30] (degrees)");
   }
   if (p.wrench_frame != "tissue" && p.wrench_frame != "blade")
     throw std::runtime_error("~wrench_frame must be tissue or blade, not '" +

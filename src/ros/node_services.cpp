@@ -87,6 +87,15 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   std::unique_ptr<Simulation> fresh;
   try {
     fresh = std::make_unique<Simulation>(initial_scene_, options_);  // outside the lock
+    // The live tuning survives a reset (dynamic_reconfigure still shows it): before, a reset
+    // went back to the scene's cut pressure, E and shape guard while the server kept the
+    // tuned values. ~set_cutting's flag too (config_.cutting_enabled follows it).
+    soft_tissue_cutting::TissueConfig tuned;
+    {
+      boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);
+      tuned = config_;
+    }
+    apply_tuning(*fresh, tuned);
   } catch (const std::exception& e) {
     res.success = false;
     res.message = "reset failed: " + shorten(e.what());
@@ -188,13 +197,21 @@ bool TissueNode::on_save(soft_tissue_cutting::SaveMesh::Request& req,
 void TissueNode::on_reconfigure(soft_tissue_cutting::TissueConfig& config, uint32_t) {
   std::lock_guard<std::mutex> lock(sim_mutex_);
   try {
-    sim_->set_cut_pressure(config.cut_pressure);
-    sim_->set_young_modulus(config.young_modulus);
-    sim_->set_cutting_enabled(config.cutting_enabled);
+    apply_tuning(*sim_, config);
     config_ = config;
+    remember_backend_locked();  // and the tuning now in use
   } catch (const std::exception& e) {
     ROS_ERROR("tissue_node: reconfigure refused: %s", e.what());
   }
+}
+
+void TissueNode::apply_tuning(Simulation& sim, const soft_tissue_cutting::TissueConfig& config) {
+  sim.set_cut_pressure(config.cut_pressure);
+  // Only a change rescales the model (a reset's fresh one stays bit for bit the scene's).
+  if (config.young_modulus != sim.scene().material.young_modulus)
+    sim.set_young_modulus(config.young_modulus);
+  sim.set_cutting_enabled(config.cutting_enabled);
+  sim.set_shape_guard_deg(config.shape_guard_deg);
 }
 
 }  // namespace ros_io

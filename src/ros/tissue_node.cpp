@@ -41,6 +41,7 @@ TissueNode::TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams param
   const bool has_pressure = pnh_.hasParam("cut_pressure");
   const bool has_young = pnh_.hasParam("young_modulus");
   const bool has_cutting = pnh_.hasParam("cutting_enabled");
+  const bool has_guard = pnh_.hasParam("shape_guard_deg");
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<soft_tissue_cutting::TissueConfig>>(
       reconfigure_mutex_, pnh_);
   {
@@ -49,9 +50,11 @@ TissueNode::TissueNode(ros::NodeHandle nh, ros::NodeHandle pnh, NodeParams param
     pnh_.getParam("cut_pressure", config_.cut_pressure);
     pnh_.getParam("young_modulus", config_.young_modulus);
     pnh_.getParam("cutting_enabled", config_.cutting_enabled);
+    pnh_.getParam("shape_guard_deg", config_.shape_guard_deg);
     if (!has_pressure) config_.cut_pressure = sim_->scene().scalpel.cut_pressure;
     if (!has_young) config_.young_modulus = sim_->scene().material.young_modulus;
     if (!has_cutting) config_.cutting_enabled = sim_->cutting_enabled();
+    if (!has_guard) config_.shape_guard_deg = sim_->scene().scalpel.shape_guard_deg;
   }
   reconfigure_->updateConfig(config_);
   reconfigure_->setCallback(

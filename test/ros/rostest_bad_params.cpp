@@ -52,6 +52,8 @@ TEST(BadParams, EachIsRefusedWithItsNameAndTheNodeExits) {
       {"_parent_transform:=[0,0,0,0,0,0]", "~parent_transform must be a list of 7 numbers"},
       {"_cut_pressure:=hard", "~cut_pressure must be a number (N)"},
       {"_cutting_enabled:=sometimes", "~cutting_enabled must be true or false"},
+      {"_shape_guard_deg:=strict", "~shape_guard_deg must be a number (degrees)"},
+      {"_shape_guard_deg:=45", "~shape_guard_deg must be in [0, 30] (degrees)"},
   };
   int k = 0;
   for (const Case& c : cases) {

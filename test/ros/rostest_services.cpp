@@ -6,6 +6,8 @@
 #include "soft_tissue_cutting/solve/blas_kernels.hpp"
 #include "test_helpers.hpp"
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <soft_tissue_cutting/Cut.h>
@@ -18,9 +20,11 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <map>
 #include <string>
 
 using tissue_test::spin_until;
@@ -168,6 +172,58 @@ TEST_F(Fixture, SetCutting) {
   EXPECT_TRUE(b.response.success);
   EXPECT_TRUE(ros::param::get("/tissue/cutting_enabled", param));
   EXPECT_TRUE(param);
+}
+
+// dynamic_reconfigure's values are what the simulation uses, and stay so through ~reset (they
+// used to fall back to the scene's while the server kept showing the tuned ones): /diagnostics
+// reports the values in use.
+TEST_F(Fixture, TuningSurvivesReset) {
+  std::map<std::string, std::string> diagnostics;
+  int seen = 0;
+  ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+        for (const auto& s : a->status)
+          if (s.name.find("simulation") != std::string::npos) {
+            for (const auto& kv : s.values) diagnostics[kv.key] = kv.value;
+            ++seen;
+          }
+      });
+  auto reconfigure = [](double pressure, double guard) {
+    dynamic_reconfigure::Reconfigure r;
+    dynamic_reconfigure::DoubleParameter p;
+    p.name = "cut_pressure";
+    p.value = pressure;
+    r.request.config.doubles.push_back(p);
+    p.name = "shape_guard_deg";
+    p.value = guard;
+    r.request.config.doubles.push_back(p);
+    return ros::service::call("/tissue/set_parameters", r);
+  };
+  // Two reports after `since`: the second was made wholly after the change.
+  auto reported = [&](const std::string& key, double value) {
+    const int since = seen;
+    return spin_until(
+        [&] {
+          const auto it = diagnostics.find(key);
+          return seen >= since + 2 && it != diagnostics.end() &&
+                 std::abs(std::stod(it->second) - value) < 1e-9;
+        },
+        5.0);
+  };
+  double pressure = 0, guard = 0;
+  ASSERT_TRUE(ros::param::get("/tissue/cut_pressure", pressure));
+  ASSERT_TRUE(ros::param::get("/tissue/shape_guard_deg", guard));
+  EXPECT_EQ(guard, 1.0) << "the scene's default shape guard";
+  ASSERT_TRUE(reported("shape guard (deg)", guard)) << "no /diagnostics with the shape guard";
+  ASSERT_TRUE(reconfigure(0.25, 5.0));
+  EXPECT_TRUE(reported("shape guard (deg)", 5.0));
+  EXPECT_TRUE(reported("cut pressure (N)", 0.25));
+  visualization_msgs::Marker reset_surface;
+  ASSERT_TRUE(reset_and_capture(&reset_surface));
+  EXPECT_TRUE(reported("shape guard (deg)", 5.0)) << "the reset dropped the tuned shape guard";
+  EXPECT_TRUE(reported("cut pressure (N)", 0.25)) << "the reset dropped the tuned cut pressure";
+  ASSERT_TRUE(reconfigure(pressure, guard));  // as the other tests expect it
+  EXPECT_TRUE(reported("shape guard (deg)", guard));
 }
 
 TEST_F(Fixture, SaveWritesReadableVtk) {

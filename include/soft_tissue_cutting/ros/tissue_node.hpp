@@ -146,10 +146,14 @@ class TissueNode {
   bool on_save(soft_tissue_cutting::SaveMesh::Request& req,
                soft_tissue_cutting::SaveMesh::Response& res);
   void on_reconfigure(soft_tissue_cutting::TissueConfig& config, uint32_t level);
+  // dynamic_reconfigure's values into `sim` (the running one, or a fresh one on ~reset).
+  // Throws what the Simulation's setters throw.
+  void apply_tuning(Simulation& sim, const soft_tissue_cutting::TissueConfig& config);
 
   // diagnostics (node_diagnostics.cpp)
   void diagnostics_thread();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  // The backend and the tuning in use, copied from sim_ (under sim_mutex_) for /diagnostics.
   void remember_backend_locked();
 
   ros::NodeHandle nh_, pnh_;
@@ -197,6 +201,9 @@ class TissueNode {
   double cut_lag_ = 0;                           // m
   std::uint64_t steps_ = 0;                      // loop thread
   std::uint64_t poses_dropped_seen_ = 0;         // loop thread: pose_input_.dropped() last warned
+  struct Tuning {  // the running simulation's tuning (remember_backend_locked, info_mutex_)
+    double cut_pressure = 0, young_modulus = 0, shape_guard_deg = 0;
+  } tuning_;
 
   // surface versions restart with each fresh Simulation: ~reset bumps it (under sim_mutex_).
   std::uint64_t sim_generation_ = 0;
