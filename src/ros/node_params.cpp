@@ -69,7 +69,7 @@ NodeParams read_params(const ros::NodeHandle& pnh) {
     // The range dynamic_reconfigure would clamp to silently, and the scene key's (SCENE.md).
     number = 0;
     read(pnh, "shape_guard_deg", number, "a number (degrees)");
-    if (!(number >= 0 && number <= 30))
+    if (!(number >= 0 && number <= kMaxShapeGuardDeg))
       throw std::runtime_error("~shape_guard_deg must be in [0, 30] (degrees)");
   }
   if (p.wrench_frame != "tissue" && p.wrench_frame != "blade")

@@ -89,7 +89,7 @@ bool TissueNode::on_reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
     fresh = std::make_unique<Simulation>(initial_scene_, options_);  // outside the lock
     // The live tuning survives a reset (dynamic_reconfigure still shows it): before, a reset
     // went back to the scene's cut pressure, E and shape guard while the server kept the
-    // tuned values. ~set_cutting's flag too (config_.cutting_enabled follows it).
+    // tuned values. (~set_cutting's flag is taken from the running simulation below.)
     soft_tissue_cutting::TissueConfig tuned;
     {
       boost::recursive_mutex::scoped_lock lock(reconfigure_mutex_);

@@ -323,10 +323,8 @@ class SceneLoader {
     if (n["cut_pressure"])
       scene_.scalpel.cut_pressure = f_.non_negative(n["cut_pressure"], "scalpel.cut_pressure");
     if (n["shape_guard_deg"]) {
-      // Above 30 deg most splits of a good mesh would be refused (a regular tet's angles are
-      // 70.5 deg, and a bisection halves some of them): the cut would no longer follow the blade.
       const double deg = f_.non_negative(n["shape_guard_deg"], "scalpel.shape_guard_deg");
-      if (deg > 30)
+      if (deg > kMaxShapeGuardDeg)
         f_.fail(n["shape_guard_deg"], "scalpel.shape_guard_deg", "must be <= 30 (degrees)");
       scene_.scalpel.shape_guard_deg = deg;
     }

@@ -321,9 +321,18 @@ struct Simulation::Impl {
     std::vector<Vec3> band_from, band_to;
     for (int k : keep) band_from.push_back((*rest_from)[k]), band_to.push_back((*rest_to)[k]);
     const CutResult r =
-        cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to, options.cut);
+        cut_band(model->mesh_for_cutting(), cut_state, band_from, band_to, cut_options());
     s.cutting_ms += ms_since(t0);
     return adopt_cut(r, s) || finished;
+  }
+
+  // The cutter's options with the scene's shape guard (docs/SCENE.md, scalpel.shape_guard_deg):
+  // the scene is its one place, whether it came from a file, was built in code or was tuned
+  // live (set_shape_guard_deg), and reset() restores it with the rest of the scene.
+  CutOptions cut_options() const {
+    CutOptions cut = options.cut;
+    cut.split_min_dihedral_deg = scene.scalpel.shape_guard_deg;
+    return cut;
   }
 
   // The stroke ended (the blade left the tissue or its incision, was removed, a new stroke
@@ -332,7 +341,7 @@ struct Simulation::Impl {
   bool finish_cut_stroke(StepStats& s) {
     stroke_to_finish = false;
     const auto t0 = Clock::now();
-    const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state, options.cut);
+    const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state, cut_options());
     s.cutting_ms += ms_since(t0);
     return adopt_cut(r, s);
   }
@@ -921,9 +930,6 @@ struct Simulation::Impl {
 Simulation::Simulation(Scene scene, SimulationOptions options) : impl_(new Impl) {
   impl_->initial = std::move(scene);
   impl_->options = std::move(options);
-  // The scene decides the shape guard (docs/SCENE.md, scalpel.shape_guard_deg): one place to
-  // set it, whether the scene came from a file or was built in code.
-  impl_->options.cut.split_min_dihedral_deg = impl_->initial.scalpel.shape_guard_deg;
   impl_->start();
   // Correct either way (solve/blas_guard.hpp), but slower when moves or the display thread
   // factor beside the loop: say so once.
@@ -1039,10 +1045,9 @@ bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
 void Simulation::set_shape_guard_deg(double degrees) {
   // The range the scene loader accepts (scalpel.shape_guard_deg, docs/SCENE.md).
-  if (!(degrees >= 0 && degrees <= 30))
+  if (!(degrees >= 0 && degrees <= kMaxShapeGuardDeg))
     throw std::invalid_argument("shape_guard_deg must be in [0, 30] degrees");
-  impl_->scene.scalpel.shape_guard_deg = degrees;
-  impl_->options.cut.split_min_dihedral_deg = degrees;
+  impl_->scene.scalpel.shape_guard_deg = degrees;  // cut_options() reads it
 }
 void Simulation::set_young_modulus(double pascal) {
   if (!(pascal > 0)) throw std::invalid_argument("young_modulus must be > 0");

@@ -59,6 +59,11 @@ struct OperationRegion {
   bool follows_blade() const { return kind == Kind::kFollow; }
 };
 
+// The largest shape guard (degrees) the scene key, the live setter and the node accept: above
+// it most splits of a good mesh would be refused (a regular tet's angles are 70.5 deg, and a
+// bisection halves some of them), so the cut would no longer follow the blade.
+constexpr double kMaxShapeGuardDeg = 30;
+
 struct ScalpelParams {
   double blade_length = 0.02;  // m, edge from the tip along local +x
   double cut_pressure = 0.5;   // N

@@ -54,7 +54,7 @@ struct SimulationOptions {
   bool wait_for_factor_ahead = false;
   // The cutter's options (docs/DESIGN.md section 8); the defaults are what it describes. Tests
   // switch a stage off to measure what it does (e.g. insert_nodes). Except the shape guard
-  // (split_min_dihedral_deg): the scene sets it (ScalpelParams::shape_guard_deg).
+  // (split_min_dihedral_deg): the scene's ScalpelParams::shape_guard_deg replaces it.
   CutOptions cut;
 };
 

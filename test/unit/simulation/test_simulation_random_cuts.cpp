@@ -419,6 +419,8 @@ TEST(SimulationRandomCuts, ShapeGuardSetterRefusesOutOfRange) {
   EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 0.0);
   sim.set_shape_guard_deg(30);
   EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 30.0);
+  sim.reset();  // back to the scene's, as the cut pressure is
+  EXPECT_EQ(sim.scene().scalpel.shape_guard_deg, 1.0);
 }
 
 // The same property on the organ-scale TetGen liver (config/scenes/liver2_surface.yaml, 56k
