@@ -1,5 +1,6 @@
 #include "cutting/cut_sweep.hpp"
 
+#include "cutting/closed_marks.hpp"
 #include "cutting/cut_smoothing.hpp"
 #include "cutting/earlier_triangles.hpp"
 #include "cutting/separation.hpp"
@@ -292,7 +293,21 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   // the skin would open the tissue ahead of the blade (the end of a curved stroke on a fine
   // liver: open faces 4 x the tolerance past the sweep with it, within tolerance without).
   const Triangles corners = nearest_first({}, state.last_corners);
-  return cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, &corners);
+  CutResult result =
+      cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, &corners);
+  if (!options.open_closed_marks) return result;
+  // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
+  const long marked_before = count_marked_face_sides(mesh);
+  if (open_closed_marks(mesh, state, state.stroke_tets, options, result) > 0) {
+    std::sort(result.changed_tets.begin(), result.changed_tets.end());
+    result.changed_tets.erase(std::unique(result.changed_tets.begin(), result.changed_tets.end()),
+                              result.changed_tets.end());
+    state.stroke_tets.insert(state.stroke_tets.end(), result.changed_tets.begin(),
+                             result.changed_tets.end());
+    result.nodes_added = static_cast<int>(result.new_nodes.size());
+    result.cut_faces_added += static_cast<int>((count_marked_face_sides(mesh) - marked_before) / 2);
+  }
+  return result;
 }
 
 }  // namespace stc

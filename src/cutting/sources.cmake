@@ -1,6 +1,7 @@
 # The cutting stage's sources of tissue_core (explicit: a new file is added here).
 list(APPEND TISSUE_CORE_SOURCES
   src/cutting/blade_path.cpp
+  src/cutting/closed_marks.cpp
   src/cutting/cut_smoothing.cpp
   src/cutting/cut_state.cpp
   src/cutting/cut_sweep.cpp

@@ -190,6 +190,12 @@ bool StrokeSurface::corner_near(const TetMesh& mesh, const CutState& state, int 
   return boundary != 0;
 }
 
+bool split_too_thin(const TetMesh& mesh, const CutState& state, int t, int a, int b, double s,
+                    const CutOptions& options) {
+  return a < b ? too_thin(mesh, state, t, {Split{a, b, s}}, options)
+               : too_thin(mesh, state, t, {Split{b, a, 1 - s}}, options);
+}
+
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi) {
   std::vector<int> tets;

@@ -144,6 +144,12 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
                            int t, int f, const CutOptions& options, StrokeSurface& surface,
                            double skin_slack, CutResult& result, std::set<FaceKey>& new_faces);
 
+// Would bisecting edge (a, b) of tet t at x_a + s (x_b - x_a) leave a piece under the volume
+// guard or the shape guard (CutOptions::min_volume_fraction, split_min_dihedral_deg), as the
+// splits above are checked?
+bool split_too_thin(const TetMesh& mesh, const CutState& state, int t, int a, int b, double s,
+                    const CutOptions& options);
+
 // The cuttable tets whose boxes overlap [lo, hi].
 std::vector<int> cuttable_tets_in(const TetMesh& mesh, const CutState& state, const Vec3& lo,
                                   const Vec3& hi);

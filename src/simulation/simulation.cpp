@@ -384,9 +384,11 @@ struct Simulation::Impl {
     if (!r.cut_anything()) return false;
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
+    // `cuts` counts steps that inserted a cut (docs/SCENE.md): a step that finishes one stroke
+    // and begins the next adopts two cuts.
+    if (!s.cutting) ++cuts;
     s.cutting = true;
     tets_split += r.tets_split;
-    ++cuts;
     return true;
   }
 

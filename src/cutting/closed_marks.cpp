@@ -1,0 +1,133 @@
+#include "cutting/closed_marks.hpp"
+
+#include "cutting/edge_bisection.hpp"
+#include "cutting/separation.hpp"
+#include "cutting/triangle_cut.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+namespace stc {
+namespace {
+
+FaceKey key_of(const Tet& tet, int f) {
+  FaceKey key = {tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
+// Bisects edge (a, b) at its midpoint if it still exists and every tet on it is cuttable and
+// passes the guards; returns the new node or -1.
+int split_midpoint(TetMesh& mesh, CutState& state, int a, int b, const CutOptions& options,
+                   CutResult& result) {
+  if (state.locked[static_cast<size_t>(a)] && state.locked[static_cast<size_t>(b)]) return -1;
+  const std::vector<int> ring = tets_with_edge(state, a, b);
+  if (ring.empty()) return -1;
+  for (int t : ring)
+    if (!state.cuttable[static_cast<size_t>(t)] ||
+        split_too_thin(mesh, state, t, a, b, 0.5, options))
+      return -1;
+  const size_t before = result.changed_tets.size();
+  const int m = bisect_edge(mesh, state, a, b, 0.5, result.changed_tets);
+  result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
+  set_on_stroke(state, m);
+  NewNode node;
+  node.index = m;
+  node.kind = NewNode::Kind::kEdgeSplit;
+  node.a = a;
+  node.b = b;
+  node.t = 0.5;
+  result.new_nodes.push_back(node);
+  return m;
+}
+
+// One round: round 0 splits an edge that another mark shares, round 1 (what round 0's marks
+// still hold shut) an edge that an opened wall shares.
+int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
+               const CutOptions& options, CutResult& result, int round) {
+  // The marked faces around the stroke, closed ones apart, and how many marks use each edge.
+  std::set<FaceKey> closed, marked, opened;
+  for (int t : tets) {
+    if (t < 0 || t >= mesh.num_tets() || !state.cuttable[static_cast<size_t>(t)]) continue;
+    for (int f = 0; f < 4; ++f) {
+      if (!mesh.is_cut_face(t, f)) continue;
+      const FaceKey key = key_of(mesh.tets[static_cast<size_t>(t)], f);
+      marked.insert(key);
+      (neighbour_across(mesh, state, t, f).first >= 0 ? closed : opened).insert(key);
+    }
+  }
+  if (closed.empty()) return 0;
+  std::map<std::pair<int, int>, int> uses;
+  for (const FaceKey& k : round == 0 ? marked : opened)
+    for (int e = 0; e < 3; ++e)
+      ++uses[{std::min(k[e], k[(e + 1) % 3]), std::max(k[e], k[(e + 1) % 3])}];
+  const size_t nodes_before = result.new_nodes.size();
+  std::vector<int> added;
+  const StrokeSurface surface(state.last_corners);
+  for (const FaceKey& k : closed) {
+    // Only a face along the stroke's surface (its corners within kOnCutSlack of its longest
+    // edge, no skin slack): a mark left closed may reach farther, and opened it would be a
+    // wall off the blade's path.
+    double face_longest = 0;
+    for (int e = 0; e < 3; ++e)
+      face_longest = std::max(face_longest, (mesh.nodes[k[e]] - mesh.nodes[k[(e + 1) % 3]]).norm());
+    bool along = true;
+    for (int e = 0; e < 3 && along; ++e)
+      along = surface.near(mesh.nodes[k[e]], kOnCutSlack * face_longest);
+    if (!along) continue;
+    // The face's longest edge another mark shares.
+    int best = -1;
+    double longest = 0;
+    for (int e = 0; e < 3; ++e) {
+      const int a = k[e], b = k[(e + 1) % 3];
+      if (uses[{std::min(a, b), std::max(a, b)}] < (round == 0 ? 2 : 1)) continue;
+      const double length = (mesh.nodes[a] - mesh.nodes[b]).norm();
+      if (length > longest) longest = length, best = e;
+    }
+    if (best >= 0) {
+      const int m = split_midpoint(mesh, state, k[best], k[(best + 1) % 3], options, result);
+      if (m >= 0) added.push_back(m);
+      continue;
+    }
+    if (round > 0) continue;
+    // A face alone: its centre, as the midpoint of (the longest edge's midpoint, the far corner).
+    for (int e = 0; e < 3; ++e) {
+      const double length = (mesh.nodes[k[e]] - mesh.nodes[k[(e + 1) % 3]]).norm();
+      if (length > longest) longest = length, best = e;
+    }
+    const int m = split_midpoint(mesh, state, k[best], k[(best + 1) % 3], options, result);
+    if (m < 0) continue;
+    added.push_back(m);
+    const int c = k[(best + 2) % 3];
+    const int n = split_midpoint(mesh, state, m, c, options, result);
+    if (n >= 0) added.push_back(n);
+  }
+  if (added.empty()) return 0;
+  std::vector<int> region;
+  for (int v : added)
+    for (int t : state.node_tets[static_cast<size_t>(v)])
+      for (int w : mesh.tets[static_cast<size_t>(t)])
+        region.insert(region.end(), state.node_tets[static_cast<size_t>(w)].begin(),
+                      state.node_tets[static_cast<size_t>(w)].end());
+  std::sort(region.begin(), region.end());
+  region.erase(std::unique(region.begin(), region.end()), region.end());
+  std::set<FaceKey> new_faces;
+  separate_along_cuts(mesh, state, region, result, new_faces);
+  return static_cast<int>(result.new_nodes.size() - nodes_before);
+}
+
+}  // namespace
+
+int open_closed_marks(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
+                      const CutOptions& options, CutResult& result) {
+  int added = open_round(mesh, state, tets, options, result, 0);
+  std::vector<int> now = tets;
+  now.insert(now.end(), result.changed_tets.begin(), result.changed_tets.end());
+  std::sort(now.begin(), now.end());
+  now.erase(std::unique(now.begin(), now.end()), now.end());
+  added += open_round(mesh, state, now, options, result, 1);
+  return added;
+}
+
+}  // namespace stc
