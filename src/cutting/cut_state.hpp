@@ -36,6 +36,9 @@ struct CutState {
   // The same stroke's bands as a face's corners are checked against: less of the margin ahead
   // of the motion (CutOptions::corner_margin_fraction), same cap.
   std::vector<std::array<Vec3, 3>> last_corners;
+  // The same stroke's bands as the blade's edge swept them: no margin beyond the tip and the
+  // heel or ahead of the motion (closed_marks.hpp opens only what lies along it), same cap.
+  std::vector<std::array<Vec3, 3>> blade_sweep;
   // Per node (grown on demand): on the current stroke's cut surface - created on it by a
   // split, taken onto it by the snap rule, or a copy made by opening it. A triangle of the
   // stroke treats these as "on" where they lie within its snap distance of its plane, and any
@@ -46,6 +49,10 @@ struct CutState {
   // Per node (grown on demand): moved onto a border of a cut once (split_along_border); it
   // is never moved there again.
   std::vector<std::uint8_t> moved_to_border;
+  // Per node (grown on demand): put inside a closed mark at a stroke's end (closed_marks.hpp).
+  // A mark with such a corner that separation still holds shut is not split again: each later
+  // stroke touching it would add another node.
+  std::vector<std::uint8_t> opened_at_end;
   // Per node (grown on demand): taken onto the current stroke's surface extended past one of
   // its borders (a tet the border runs through is cut by a triangle's whole plane, and a
   // crossing beyond the triangle moved this node onto that plane). Not on the cut - no face with

@@ -269,6 +269,12 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none,
                                    borders, kSkinCornerSlack, &corner_surface, &marked_in);
   keep_in_stroke(state.last_corners, corners, continues);
+  Triangles swept;
+  for (size_t i = 0; i + 1 < from.size(); ++i) {
+    swept.push_back({from[i], from[i + 1], to[i + 1]});
+    swept.push_back({from[i], to[i + 1], to[i]});
+  }
+  keep_in_stroke(state.blade_sweep, swept, continues);
   // The stroke so far (kMaxStrokeTriangles).
   keep_in_stroke(state.last_sweep, sweep, continues, &state.last_sweep_bands);
   state.last_sweep_end = {to.front(), to.back()};

@@ -343,7 +343,9 @@ struct Simulation::Impl {
     const auto t0 = Clock::now();
     const CutResult r = finish_stroke(model->mesh_for_cutting(), cut_state, cut_options());
     s.cutting_ms += ms_since(t0);
-    return adopt_cut(r, s);
+    const bool cut = adopt_cut(r, s);
+    s.stroke_finished |= cut;
+    return cut;
   }
 
   // The model after a cut changed the mesh; returns whether the cut did (CutResult::cut_anything).
@@ -384,11 +386,9 @@ struct Simulation::Impl {
     if (!r.cut_anything()) return false;
     s.tets_split += r.tets_split;
     s.nodes_added += r.nodes_added;
-    // `cuts` counts steps that inserted a cut (docs/SCENE.md): a step that finishes one stroke
-    // and begins the next adopts two cuts.
-    if (!s.cutting) ++cuts;
     s.cutting = true;
     tets_split += r.tets_split;
+    ++cuts;  // cut insertions: a step that finishes one stroke and begins the next makes two
     return true;
   }
 

@@ -62,7 +62,10 @@ struct SimulationOptions {
 struct StepStats {
   std::uint64_t step = 0;
   bool in_contact = false;
-  bool cutting = false;                // this step inserted a cut
+  bool cutting = false;  // this step inserted a cut
+  // Of which: the end of a stroke, conformed and opened (finish_stroke, on the step after the
+  // blade's last cut; cutting/cut_sweep.hpp). That step may hold the blade still.
+  bool stroke_finished = false;
   Vec3 contact_force = Vec3::Zero();   // N, reaction of the tissue on the blade (scene frame)
   Vec3 contact_torque = Vec3::Zero();  // N m, its moment about the blade tip (scene frame)
   std::vector<int> contact_nodes;      // the nodes the blade holds this step, ascending

@@ -294,24 +294,23 @@ TEST(CutFidelity, ShapeGuardOnOneStroke) {
 
 // CutOptions::open_closed_marks (cutting/closed_marks.hpp): the marks a stroke's end holds shut
 // because all their corners lie on the cut's border get a node inside the cut and open. The
-// thigh's curved vertical slow stroke (a hole at its end, beside four closed marks): measured
-// 1.24 -> 1.14 x the Hausdorff tolerance, 4 -> 2 closed cut faces; over the 40 strokes of the
-// matrix 213 -> 73 closed cut faces, the least opening 93.2 -> 95.9 %, the summed excess over
-// the tolerance 6.29 -> 5.40 (21 strokes within it either way).
+// 12k TetGen liver's 45-degree straight 3 mm stroke: measured 0.88 -> 0.69 x the Hausdorff
+// tolerance, 94.8 -> 95.9 % opened; over the 40 strokes of the matrix 213 -> 121 closed cut
+// faces, the least opening 93.2 -> 95.5 %, the summed excess over the tolerance 6.29 -> 5.38.
 TEST(CutFidelity, OpeningClosedMarksAtAStrokesEnd) {
   Figures with, without;
   int closed_with = 0, closed_without = 0;
   for (const bool open : {false, true}) {
-    auto b = make_bench("thigh");
+    auto b = make_bench("liver-5000");
     b->options.open_closed_marks = open;
-    const Figures fig = run_stroke(*b, variant(b->stroke, 0, 0.2e-3, true),
+    const Figures fig = run_stroke(*b, variant(b->stroke, 45, 3e-3, false),
                                    open ? "closed marks opened" : "closed marks kept");
     EXPECT_TRUE(fig.violated.empty()) << fig.line;
     (open ? with : without) = fig;
     (open ? closed_with : closed_without) = test::closed_cut_faces(b->mesh);
   }
   EXPECT_LT(closed_with, closed_without) << with.line;
-  EXPECT_LE(with.f.hausdorff_over_tolerance, 0.95 * without.f.hausdorff_over_tolerance)
+  EXPECT_LE(with.f.hausdorff_over_tolerance, 0.9 * without.f.hausdorff_over_tolerance)
       << with.line << "\n"
       << without.line;
   EXPECT_GE(with.f.opening(), without.f.opening()) << with.line << "\n" << without.line;

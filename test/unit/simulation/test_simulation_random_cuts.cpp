@@ -382,21 +382,28 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
                 sim.counts().tets, operation_min_dihedral(sim));
   }
   // Without it, and with the default 1 deg, the same first seed: the thin tets a 5 deg guard
-  // prevents, and the floor the default keeps.
+  // prevents, and the floor the default keeps (the lowest after any stroke: the smoothing and
+  // flips of later strokes may raise the last one).
   for (const double guard : {0.0, 1.0}) {
     Scene plain_scene = scene;
     plain_scene.scalpel.shape_guard_deg = guard;
     Simulation plain(plain_scene);
     std::mt19937 rng(1u);
-    for (int k = 0; k < 100; ++k) plain.cut_along(random_liver_stroke(rng, centre));
-    std::printf("guard %.0f deg, seed 1: min dihedral %.2f deg, %d tets under 5 deg\n", guard,
-                operation_min_dihedral(plain), thin_operation_tets(plain));
+    double lowest = 180;
+    for (int k = 0; k < 100; ++k) {
+      plain.cut_along(random_liver_stroke(rng, centre));
+      lowest = std::min(lowest, operation_min_dihedral(plain));
+    }
+    std::printf(
+        "guard %.0f deg, seed 1: min dihedral %.2f deg (lowest after a stroke %.2f), %d "
+        "tets under 5 deg\n",
+        guard, operation_min_dihedral(plain), lowest, thin_operation_tets(plain));
     EXPECT_GT(thin_operation_tets(plain), 50) << "guard " << guard;
     EXPECT_LT(operation_min_dihedral(plain), 2.0) << "guard " << guard;
     if (guard > 0) {
-      EXPECT_GE(operation_min_dihedral(plain), guard - 1e-6);
+      EXPECT_GE(lowest, guard - 1e-6);
     } else {
-      EXPECT_LT(operation_min_dihedral(plain), 1.0);
+      EXPECT_LT(lowest, 1.0);
     }
   }
 }
