@@ -45,13 +45,7 @@ int split_midpoint(TetMesh& mesh, CutState& state, int a, int b, const CutOption
   if (state.opened_at_end.size() <= static_cast<size_t>(m))
     state.opened_at_end.resize(static_cast<size_t>(m) + 1, 0);
   state.opened_at_end[static_cast<size_t>(m)] = 1;
-  NewNode node;
-  node.index = m;
-  node.kind = NewNode::Kind::kEdgeSplit;
-  node.a = a;
-  node.b = b;
-  node.t = 0.5;
-  result.new_nodes.push_back(node);
+  result.new_nodes.push_back(NewNode::on_edge(m, a, b, 0.5));
   return m;
 }
 

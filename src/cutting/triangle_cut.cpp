@@ -381,13 +381,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
     tri.set_on(m);
     if (!beyond.count(edge)) set_on_stroke(state, m);
-    NewNode node;
-    node.index = m;
-    node.kind = NewNode::Kind::kEdgeSplit;
-    node.a = edge.first;
-    node.b = edge.second;
-    node.t = t;
-    result.new_nodes.push_back(node);
+    result.new_nodes.push_back(NewNode::on_edge(m, edge.first, edge.second, t));
   }
 }
 
@@ -514,13 +508,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
     result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
     tri.set_on(m);
     set_on_stroke(state, m);
-    NewNode node;
-    node.index = m;
-    node.kind = NewNode::Kind::kEdgeSplit;
-    node.a = edge.first;
-    node.b = edge.second;
-    node.t = t;
-    result.new_nodes.push_back(node);
+    result.new_nodes.push_back(NewNode::on_edge(m, edge.first, edge.second, t));
   }
 }
 

@@ -22,6 +22,17 @@ struct NewNode {
   double t = 0;
   std::array<int, 4> corners{};     // kInTet only
   std::array<double, 4> weights{};  // kInTet only
+
+  // Node `index` made on edge (a, b) at x_a + t (x_b - x_a).
+  static NewNode on_edge(int index, int a, int b, double t) {
+    NewNode node;
+    node.index = index;
+    node.kind = Kind::kEdgeSplit;
+    node.a = a;
+    node.b = b;
+    node.t = t;
+    return node;
+  }
 };
 
 struct CutOptions {

@@ -195,13 +195,7 @@ void split_edge(HybridModel& h, int a, int b) {
     changed.push_back(m.num_tets() - 1);
   }
   ASSERT_FALSE(changed.empty());
-  NewNode node;
-  node.index = mid;
-  node.kind = NewNode::Kind::kEdgeSplit;
-  node.a = a;
-  node.b = b;
-  node.t = 0.5;
-  h.update_operation_part(changed, {node});
+  h.update_operation_part(changed, {NewNode::on_edge(mid, a, b, 0.5)});
 }
 
 // An edge of a part-1 tet between nodes of the given sets.
