@@ -11,12 +11,6 @@
 namespace stc {
 namespace {
 
-FaceKey key_of(const Tet& tet, int f) {
-  FaceKey key = {tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
-  std::sort(key.begin(), key.end());
-  return key;
-}
-
 // The shape guard on these splits (as CutOptions::split_min_dihedral_deg, at least this): they
 // are made for the opening, not to follow the blade, so they may be refused where the cut's own
 // may not. Measured (stop 45) over 100 random strokes on the sagging TetGen liver, seeds
@@ -42,9 +36,7 @@ int split_midpoint(TetMesh& mesh, CutState& state, int a, int b, const CutOption
   const int m = bisect_edge(mesh, state, a, b, 0.5, result.changed_tets);
   result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
   set_on_stroke(state, m);
-  if (state.opened_at_end.size() <= static_cast<size_t>(m))
-    state.opened_at_end.resize(static_cast<size_t>(m) + 1, 0);
-  state.opened_at_end[static_cast<size_t>(m)] = 1;
+  set_opened_at_end(state, m);
   result.new_nodes.push_back(NewNode::on_edge(m, a, b, 0.5));
   return m;
 }
@@ -59,7 +51,7 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
     if (t < 0 || t >= mesh.num_tets() || !state.cuttable[static_cast<size_t>(t)]) continue;
     for (int f = 0; f < 4; ++f) {
       if (!mesh.is_cut_face(t, f)) continue;
-      const FaceKey key = key_of(mesh.tets[static_cast<size_t>(t)], f);
+      const FaceKey key = face_key(mesh.tets[static_cast<size_t>(t)], f);
       marked.insert(key);
       (neighbour_across(mesh, state, t, f).first >= 0 ? closed : opened).insert(key);
     }
@@ -81,8 +73,7 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
       face_longest = std::max(face_longest, (mesh.nodes[k[e]] - mesh.nodes[k[(e + 1) % 3]]).norm());
     bool along = true;
     for (int v : k)  // made at an earlier stroke's end (this one's second round may use its own)
-      along = along && !(v < first_new && static_cast<size_t>(v) < state.opened_at_end.size() &&
-                         state.opened_at_end[static_cast<size_t>(v)]);
+      along = along && !(v < first_new && was_opened_at_end(state, v));
     for (int e = 0; e < 3 && along; ++e)
       along = surface.near(mesh.nodes[k[e]], kOnCutSlack * face_longest);
     if (!along) continue;
@@ -132,12 +123,17 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
 int open_closed_marks(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
                       const CutOptions& options, CutResult& result) {
   const int first_new = mesh.num_nodes();
-  int added = open_round(mesh, state, tets, options, result, 0, first_new);
-  std::vector<int> now = tets;
+  // The stroke's tets repeat (CutState::stroke_tets): each once, and for the second round with
+  // those the first one changed.
+  const auto unique = [](std::vector<int> v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    return v;
+  };
+  std::vector<int> now = unique(tets);
+  int added = open_round(mesh, state, now, options, result, 0, first_new);
   now.insert(now.end(), result.changed_tets.begin(), result.changed_tets.end());
-  std::sort(now.begin(), now.end());
-  now.erase(std::unique(now.begin(), now.end()), now.end());
-  added += open_round(mesh, state, now, options, result, 1, first_new);
+  added += open_round(mesh, state, unique(std::move(now)), options, result, 1, first_new);
   return added;
 }
 

@@ -95,6 +95,13 @@ inline void set_on_extension(CutState& state, int v) {
   if (state.on_extension.size() <= static_cast<size_t>(v)) state.on_extension.resize(v + 1, 0);
   state.on_extension[v] = 1;
 }
+inline bool was_opened_at_end(const CutState& state, int v) {
+  return static_cast<size_t>(v) < state.opened_at_end.size() && state.opened_at_end[v];
+}
+inline void set_opened_at_end(CutState& state, int v) {
+  if (state.opened_at_end.size() <= static_cast<size_t>(v)) state.opened_at_end.resize(v + 1, 0);
+  state.opened_at_end[v] = 1;
+}
 inline bool was_moved_to_border(const CutState& state, int v) {
   return static_cast<size_t>(v) < state.moved_to_border.size() && state.moved_to_border[v];
 }

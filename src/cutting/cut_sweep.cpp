@@ -106,6 +106,27 @@ Triangles spaced_bands(const Triangles& stroke, const std::vector<int>& bands, d
   return out;
 }
 
+// A cut's bookkeeping once it has changed the mesh: result.changed_tets sorted and unique, the
+// ones from `changed_from` on (those this phase added) in the stroke's tets, and the counts.
+void settle(const TetMesh& mesh, CutState& state, CutResult& result, size_t changed_from,
+            long marked_before) {
+  const auto unique = [](std::vector<int>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
+  std::vector<int> added(result.changed_tets.begin() + static_cast<long>(changed_from),
+                         result.changed_tets.end());
+  unique(added);
+  state.stroke_tets.insert(state.stroke_tets.end(), added.begin(), added.end());
+  unique(result.changed_tets);
+  if (state.stroke_tets.size() > 2 * mesh.tets.size())
+    unique(state.stroke_tets);  // a long stroke: no tet twice
+  result.nodes_added = static_cast<int>(result.new_nodes.size());
+  // Net new cut faces: each face is marked on both of its sides (open or closed), and a cut
+  // face halved by a later split counts as one more.
+  result.cut_faces_added += static_cast<int>((count_marked_face_sides(mesh) - marked_before) / 2);
+}
+
 CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const std::vector<std::array<Vec3, 3>>& triangles,
                         const CutOptions& options,
@@ -165,20 +186,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
       if (state.cuttable[t]) region.push_back(t);
     separate_along_cuts(mesh, state, region, result, new_faces);
   }
-  std::sort(result.changed_tets.begin(), result.changed_tets.end());
-  result.changed_tets.erase(std::unique(result.changed_tets.begin(), result.changed_tets.end()),
-                            result.changed_tets.end());
-  state.stroke_tets.insert(state.stroke_tets.end(), result.changed_tets.begin(),
-                           result.changed_tets.end());
-  if (state.stroke_tets.size() > 2 * mesh.tets.size()) {  // a long stroke: no tet twice
-    std::sort(state.stroke_tets.begin(), state.stroke_tets.end());
-    state.stroke_tets.erase(std::unique(state.stroke_tets.begin(), state.stroke_tets.end()),
-                            state.stroke_tets.end());
-  }
-  result.nodes_added = static_cast<int>(result.new_nodes.size());
-  // Net new cut faces: each face is marked on both of its sides (open or closed), and a cut
-  // face halved by a later split counts as one more.
-  result.cut_faces_added = static_cast<int>((count_marked_face_sides(mesh) - marked_before) / 2);
+  settle(mesh, state, result, 0, marked_before);
   return result;
 }
 
@@ -304,15 +312,9 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);
-  if (open_closed_marks(mesh, state, state.stroke_tets, options, result) > 0) {
-    std::sort(result.changed_tets.begin(), result.changed_tets.end());
-    result.changed_tets.erase(std::unique(result.changed_tets.begin(), result.changed_tets.end()),
-                              result.changed_tets.end());
-    state.stroke_tets.insert(state.stroke_tets.end(), result.changed_tets.begin(),
-                             result.changed_tets.end());
-    result.nodes_added = static_cast<int>(result.new_nodes.size());
-    result.cut_faces_added += static_cast<int>((count_marked_face_sides(mesh) - marked_before) / 2);
-  }
+  const size_t changed_before = result.changed_tets.size();
+  if (open_closed_marks(mesh, state, state.stroke_tets, options, result) > 0)
+    settle(mesh, state, result, changed_before, marked_before);
   return result;
 }
 

@@ -43,12 +43,6 @@ bool is_interior_marked(const TetMesh& mesh, const CutState& state, int t, int f
   return mesh.is_cut_face(t, f) && neighbour_across(mesh, state, t, f).first >= 0;
 }
 
-FaceKey face_key(const Tet& tet, int f) {
-  FaceKey key = {tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
-  std::sort(key.begin(), key.end());
-  return key;
-}
-
 // Unmarks closed marked face f of tet t on both of its tets.
 void unmark_face(TetMesh& mesh, const CutState& state, int t, int f, std::set<FaceKey>& new_faces) {
   const auto [other, other_face] = neighbour_across(mesh, state, t, f);

@@ -295,9 +295,7 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, Flip flip, CutResult& res
     const Tet& k = mesh.tets[static_cast<size_t>(t)];
     for (int f = 0; f < 4; ++f)
       if (mesh.is_cut_face(t, f)) {
-        FaceKey key = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
-        std::sort(key.begin(), key.end());
-        marked.insert(key);
+        marked.insert(face_key(k, f));
       }
     for (int v : k) {
       auto& star = state.node_tets[static_cast<size_t>(v)];
@@ -322,9 +320,7 @@ std::vector<int> apply(TetMesh& mesh, CutState& state, Flip flip, CutResult& res
     std::uint8_t bits = 0;
     const Tet& k = flip.tets[n];
     for (int f = 0; f < 4; ++f) {
-      FaceKey key = {k[kTetFaces[f][0]], k[kTetFaces[f][1]], k[kTetFaces[f][2]]};
-      std::sort(key.begin(), key.end());
-      if (marked.count(key)) bits |= static_cast<std::uint8_t>(1u << f);
+      if (marked.count(face_key(k, f))) bits |= static_cast<std::uint8_t>(1u << f);
     }
     mesh.cut_faces[static_cast<size_t>(t)] = bits;
     for (int i = 0; i < 4; ++i)  // a new edge may be longer than any before (the bound holds)

@@ -10,6 +10,7 @@
 #include "cutting/cut_state.hpp"
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -20,6 +21,13 @@
 namespace stc {
 
 using FaceKey = std::array<int, 3>;  // sorted node triple
+
+// Local face f of `tet` as a FaceKey.
+inline FaceKey face_key(const Tet& tet, int f) {
+  FaceKey key = {tet[kTetFaces[f][0]], tet[kTetFaces[f][1]], tet[kTetFaces[f][2]]};
+  std::sort(key.begin(), key.end());
+  return key;
+}
 
 // Each node's longest edge (the scale its "on the cut" test is relative to), computed on
 // demand and kept while the mesh does not change: the mark phase classifies the same nodes
