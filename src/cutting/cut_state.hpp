@@ -33,9 +33,6 @@ struct CutState {
   // triangles would not claim.
   std::vector<std::array<Vec3, 3>> last_sweep;
   std::vector<int> last_sweep_bands;  // how many of last_sweep each band gave, oldest first
-  // The same stroke's bands as a face's corners are checked against: less of the margin ahead
-  // of the motion (CutOptions::corner_margin_fraction), same cap.
-  std::vector<std::array<Vec3, 3>> last_corners;
   // The same stroke's bands as the blade's edge swept them: no margin beyond the tip and the
   // heel or ahead of the motion (closed_marks.hpp opens only what lies along it), same cap.
   std::vector<std::array<Vec3, 3>> blade_sweep;
@@ -67,6 +64,7 @@ struct CutState {
   // next band carries the cut on from; finish_stroke conforms the cut to it (cut_sweep.hpp).
   std::vector<std::array<Vec3, 3>> last_band;
   std::vector<std::array<Vec3, 2>> last_front;  // segments, each on triangle 2k + 1
+  std::vector<Vec3> last_front_motion;          // per point of the front (tip first): unit, or 0
   // The tets the current stroke changed (may repeat): smoothed when the next one begins
   // (cut_smoothing.hpp).
   std::vector<int> stroke_tets;

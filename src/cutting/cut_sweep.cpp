@@ -132,8 +132,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const CutOptions& options,
                         const std::vector<std::array<Vec3, 3>>& also_mark_in,
                         const std::vector<CutBorder>& borders, double skin_slack,
-                        const std::vector<std::array<Vec3, 3>>* corner_surface,
-                        const std::vector<std::array<Vec3, 3>>* marked_in) {
+                        const std::vector<std::array<Vec3, 3>>* marked_in, const BladeStop* stop) {
   CutResult result;
   if (also_mark_in.empty()) {
     // A new stroke: the last one's cut is complete, so its tets' shapes come first (not when it
@@ -165,7 +164,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
       split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
                          border.p1, options, stroke, result);
-  StrokeSurface marks(corner_surface ? *corner_surface : surface);
+  StrokeSurface marks(surface);
+  if (stop) marks.set_stop(stop->line, stop->motion, stop->reach, stop->slack_fraction);
   // The mesh no longer changes: every classification shares the nodes' scales.
   NodeScales scales;
   for (auto& tri : cut) {
@@ -230,14 +230,9 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     return line;
   };
   std::vector<Vec3> a = extend_ends(from), b = extend_ends(to);
-  // c: the front with only corner_margin_fraction of the margin ahead: where the faces the band
-  // opens may reach (a face's corners must lie on the band up to there).
-  std::vector<Vec3> c = b;
   for (size_t i = 0; i < a.size(); ++i) {
     const Vec3 motion = b[i] - a[i];
-    if (!(motion.norm() > 0)) continue;
-    b[i] += margin * motion.normalized();
-    c[i] += options.corner_margin_fraction * margin * motion.normalized();
+    if (motion.norm() > 0) b[i] += margin * motion.normalized();
   }
   // Each quad (a_i, a_i+1, b_i+1, b_i) as two triangles, tip side first as a single edge's
   // sweep (A0, B0, B1), (A0, B1, A1).
@@ -259,24 +254,24 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     state.border_from[e] = now[e];
   }
   const std::vector<std::array<Vec3, 3>> none;
-  // The surface a face's corners must lie on (mark_faces_on_triangle): the stroke's bands with
-  // only part of the margin ahead of the motion (CutOptions::corner_margin_fraction). With all
-  // of it, the faces the last band opened reached a quarter of an element past where the
-  // stroke ended, more than the tolerance where the elements there are smaller than along the
-  // band (the thigh's straight stroke: 1.7 x; 0.9 x with three quarters).
-  std::vector<std::array<Vec3, 3>> corners;
-  for (size_t i = 0; i + 1 < a.size(); ++i) {
-    corners.push_back({a[i], a[i + 1], c[i + 1]});
-    corners.push_back({a[i], c[i + 1], c[i]});
-  }
-  if (!continues) state.last_corners.clear();
-  const Triangles corner_surface = nearest_first(corners, state.last_corners);
   const Triangles marked_in =
       continues ? spaced_bands(state.last_sweep, state.last_sweep_bands, kBandSpacing * margin)
                 : none;
-  CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none,
-                                   borders, kSkinCornerSlack, &corner_surface, &marked_in);
-  keep_in_stroke(state.last_corners, corners, continues);
+  // A face the band opens may reach only a little ahead of the blade's edge (CutOptions::
+  // front_corner_reach), though the tissue is split the whole margin ahead.
+  BladeStop stop;
+  stop.line = extend_ends(to);
+  for (size_t i = 0; i < to.size(); ++i) {
+    const Vec3 motion = to[i] - from[i];
+    stop.motion.push_back(motion.norm() > 0 ? Vec3(motion.normalized()) : Vec3::Zero());
+  }
+  stop.reach = options.front_corner_reach * margin;
+  stop.slack_fraction = options.front_corner_slack;
+  state.last_front_motion = stop.motion;
+  const bool limited = options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
+  CutResult result =
+      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none, borders,
+                    kSkinCornerSlack, &marked_in, limited ? &stop : nullptr);
   Triangles swept;
   for (size_t i = 0; i + 1 < from.size(); ++i) {
     swept.push_back({from[i], from[i + 1], to[i + 1]});
@@ -306,9 +301,18 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   // No skin slack here: the front is where the blade stopped, and a face reaching past it at
   // the skin would open the tissue ahead of the blade (the end of a curved stroke on a fine
   // liver: open faces 4 x the tolerance past the sweep with it, within tolerance without).
-  const Triangles corners = nearest_first({}, state.last_corners);
-  CutResult result =
-      cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, &corners);
+  // Nor may a face reach past the front by more than its corners' slack (CutOptions::
+  // front_corner_reach): the front is conformed now, a face beyond it would stay open.
+  BladeStop stop;
+  for (const auto& segment : state.last_front) {
+    if (stop.line.empty()) stop.line.push_back(segment[0]);
+    stop.line.push_back(segment[1]);
+  }
+  stop.motion = state.last_front_motion;
+  stop.slack_fraction = 1;
+  const bool limited = options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
+  CutResult result = cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0,
+                                   nullptr, limited ? &stop : nullptr);
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);

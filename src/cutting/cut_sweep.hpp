@@ -47,23 +47,29 @@ struct CutBorder {
 // was cut since the last call; the stroke may go on afterwards.
 CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& options = {});
 
+// Where the blade's edge stands, as a limit on how far ahead of it (along its motion) a marked
+// face's corner may lie: reach + slack_fraction x the corner's slack (StrokeSurface::set_stop,
+// CutOptions::front_corner_reach).
+struct BladeStop {
+  std::vector<Vec3> line;    // tip first
+  std::vector<Vec3> motion;  // per point of line: unit, or 0 where it does not move
+  double reach = 0;
+  double slack_fraction = 0;
+};
+
 // Any list of planar triangles, inserted as one cut (one separation at the end).
 // also_mark_in: earlier triangles of the same stroke; faces this cut creates that lie in one of
 // them are marked too (the split around a new triangle can expose a face of an old one).
 // borders: where the cut surface ends inside the tissue; the faces on the cut are split there
 // (split_along_border) so that the cut opens up to them.
 // skin_slack: as mark_faces_on_triangle's (triangle_cut.hpp).
-// corner_surface: the surface a marked face's corners must lie on (default: the triangles and
-// also_mark_in).
 // marked_in: the earlier triangles whose faces are marked (default also_mark_in): a slow
 // stroke's bands thinned (cut_band).
-CutResult cut_triangles(TetMesh& mesh, CutState& state,
-                        const std::vector<std::array<Vec3, 3>>& triangles,
-                        const CutOptions& options = {},
-                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
-                        const std::vector<CutBorder>& borders = {},
-                        double skin_slack = kSkinCornerSlack,
-                        const std::vector<std::array<Vec3, 3>>* corner_surface = nullptr,
-                        const std::vector<std::array<Vec3, 3>>* marked_in = nullptr);
+// stop: where the blade's edge stands, if a marked face's corners are limited ahead of it.
+CutResult cut_triangles(
+    TetMesh& mesh, CutState& state, const std::vector<std::array<Vec3, 3>>& triangles,
+    const CutOptions& options = {}, const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
+    const std::vector<CutBorder>& borders = {}, double skin_slack = kSkinCornerSlack,
+    const std::vector<std::array<Vec3, 3>>* marked_in = nullptr, const BladeStop* stop = nullptr);
 
 }  // namespace stc

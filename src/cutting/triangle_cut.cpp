@@ -181,8 +181,36 @@ bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
   return false;
 }
 
+void StrokeSurface::set_stop(std::vector<Vec3> line, std::vector<Vec3> motion, double reach,
+                             double slack_fraction) {
+  stop_ = std::move(line);
+  stop_motion_ = std::move(motion);
+  stop_reach_ = reach;
+  stop_slack_fraction_ = slack_fraction;
+  if (stop_motion_.size() != stop_.size()) stop_.clear();
+}
+
+double StrokeSurface::ahead_of_stop(const Vec3& x) const {
+  double nearest = std::numeric_limits<double>::infinity(), ahead = -1;
+  for (size_t i = 0; i + 1 < stop_.size(); ++i) {
+    const Vec3 d = stop_[i + 1] - stop_[i];
+    const double u =
+        d.squaredNorm() > 0 ? std::clamp((x - stop_[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    const Vec3 at = stop_[i] + u * d;
+    const double distance = (x - at).norm();
+    if (distance >= nearest) continue;
+    nearest = distance;
+    Vec3 motion = (1 - u) * stop_motion_[i] + u * stop_motion_[i + 1];
+    ahead = motion.norm() > 0 ? (x - at).dot(motion.normalized()) : -1;
+  }
+  return ahead;
+}
+
 bool StrokeSurface::corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
                                 double skin_slack) {
+  if (stop_.size() >= 2 &&
+      ahead_of_stop(mesh.nodes[v]) > stop_reach_ + stop_slack_fraction_ * slack)
+    return false;
   if (near_node(mesh, v, slack)) return true;
   if (!near_node(mesh, v, skin_slack * slack)) return false;
   std::int8_t& boundary = known_[v].on_boundary;

@@ -86,13 +86,24 @@ class StrokeSurface {
   // for every corner of every candidate face, 16 % of an organ cutting step (callgrind).
   bool corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
                    double skin_slack);
+  // Where the blade's edge stands (a polyline, tip first) and which way each of its points
+  // moves (unit): a corner may lie at most `reach` + `slack_fraction` x its slack ahead of it
+  // (corner_near), whatever its distance to the triangles. Without it a corner is limited only
+  // by that distance, which reaches past the blade by the triangles' margin plus the slack.
+  void set_stop(std::vector<Vec3> line, std::vector<Vec3> motion, double reach,
+                double slack_fraction);
 
  private:
   // The distance to the first triangle (in order: nearest first) within slack, or -1.
   double first_within(const Vec3& x, double slack) const;
 
+  // How far x lies ahead of the stop line (its nearest point's motion; < 0 behind).
+  double ahead_of_stop(const Vec3& x) const;
+
   std::vector<std::array<Vec3, 3>> triangles_;
   std::vector<Vec3> lo_, hi_;
+  std::vector<Vec3> stop_, stop_motion_;
+  double stop_reach_ = 0, stop_slack_fraction_ = 0;
   // A triangle within near_at (near for every slack >= it); none within far_below.
   struct Known {
     double near_at = std::numeric_limits<double>::infinity(), far_below = -1;

@@ -104,10 +104,17 @@ struct CutOptions {
   // the margin ahead lets the opening follow the blade to within about an element.
   double front_margin = -1;
   double front_margin_fraction = 0.25;
-  // How much of that margin ahead of the motion a face the band opens may reach: its corners
-  // must lie on the band cut short there (so a stroke's opening ends at most this much of the
-  // margin past where the blade stopped; the tissue ahead is split by the whole margin).
-  double corner_margin_fraction = 0.75;
+  // How far ahead of the blade's edge (along its motion) a face the band opens may reach while
+  // the stroke goes on: each corner at most front_corner_reach x the front margin plus
+  // front_corner_slack x its slack (kOnCutSlack x the face's longest edge, cutting/
+  // triangle_cut.hpp) ahead of the edge; at the stroke's end (finish_stroke) at most its slack
+  // ahead of where the blade stopped. The tissue ahead is still split by the whole margin. A
+  // face opened farther ahead stays open if the blade stops there: the fine liver2's straight
+  // strokes opened a face with a corner 1.19 mm past the blade's last position (1.32 x the
+  // Hausdorff tolerance) when the limit was only the distance to the band cut short at 3/4 of
+  // the margin (docs/DESIGN.md section 8, "Mark"). Negative: no limit.
+  double front_corner_reach = 0.25;
+  double front_corner_slack = 0.25;
 };
 
 struct CutResult {
