@@ -85,12 +85,14 @@ struct CutOptions {
   // as min_volume_fraction refuses a piece too small: the crossing edge's end nearest the cut is
   // snapped (counts as on it, never moved), a border's crossing is dropped. The cut then lies up
   // to half an edge off the blade where it would have made a sliver. The default, 1 deg, leaves
-  // the issue 9 stroke matrix's fidelity as it is without (21 of 40 strokes within the Hausdorff
+  // the issue 9 stroke matrix's fidelity as it was without (stop 44: 21 of 40 within the Hausdorff
   // tolerance, least opening 93.2 %) and lifts the operation part's smallest angle after 100
   // random strokes on a sagging TetGen liver from 0.55-1.02 deg (off) to at least 1 deg. 5 deg
-  // leaves 0-2 tets under 5 deg instead of 124-171 (smallest 4.51-5.02, the uncut part's own
-  // 4.51) but costs fidelity: 13 of 40 within tolerance, one opening 88.8 % (docs/DESIGN.md
-  // section 8, "Shape guard", eq. (20c)). A Simulation takes the scene's value
+  // leaves 0-2 tets under 5 deg instead of 93-277 (smallest 4.51-5.10, the uncut part's own
+  // 4.51) for one stroke of the matrix since stop 46 (29 of 40 within tolerance, least opening
+  // 92.9 %), but keeps the thin tets of a mesh without a quality bound (TetGen -pQ) from being
+  // split: a long stroke across one opened 70 % instead of 145 % (docs/DESIGN.md section 8,
+  // "Shape guard", eq. (20c)). A Simulation takes the scene's value
   // (scalpel.shape_guard_deg, docs/SCENE.md), whose default is this one.
   double split_min_dihedral_deg = 1;
   // Barycentric slack of "inside the sweep triangle" (crossing points and face centroids),
