@@ -200,5 +200,38 @@ TEST(EarlierTriangles, CornerTestIsNearOrOnTheSkinAndNearerAtEveryAskedSlack) {
   EXPECT_GT(near, skin_only);
 }
 
+// The limit ahead of the blade (StrokeSurface::set_stop, CutOptions::front_corner_reach): a
+// corner near the surface is refused when it lies farther ahead of the blade's edge, along its
+// motion, than the reach plus slack_fraction x its slack - skin corners too - and the rest is
+// answered as without the limit. The cube's nodes against its plane z = 0.02 (a grid plane),
+// the blade's edge along y at x = 0.0185 moving along +x, reach 1 mm, a quarter of the slack:
+// the grid nodes at x = 0.02 (1.5 mm ahead) pass at a slack of 2.5 or 4 mm, not at 0.1 mm; those
+// at x = 0.03 and 0.04 never do.
+TEST(EarlierTriangles, CornerTestStopsAheadOfTheBlade) {
+  TetMesh mesh = cube();
+  const CutState state = make_cut_state(mesh, {}, {});
+  const double z = 0.02, edge_x = 0.0185, reach = 1e-3, fraction = 0.25;
+  const Triangles plane = {{Vec3(-0.01, -0.01, z), Vec3(0.05, -0.01, z), Vec3(0.05, 0.05, z)},
+                           {Vec3(-0.01, -0.01, z), Vec3(0.05, 0.05, z), Vec3(-0.01, 0.05, z)}};
+  StrokeSurface limited(plane), unlimited(plane);
+  limited.set_stop({Vec3(edge_x, -0.01, z), Vec3(edge_x, 0.05, z)}, {Vec3::UnitX(), Vec3::UnitX()},
+                   reach, fraction);
+  int refused = 0, kept_ahead = 0;
+  for (const double slack : {1e-4, 4e-3, 2.5e-3}) {
+    for (int v = 0; v < mesh.num_nodes(); ++v) {
+      const Vec3& x = mesh.nodes[v];
+      const bool without = unlimited.corner_near(mesh, state, v, slack, kSkinCornerSlack);
+      const double ahead = x.x() - edge_x;
+      const bool expected = without && ahead <= reach + fraction * slack;
+      ASSERT_EQ(limited.corner_near(mesh, state, v, slack, kSkinCornerSlack), expected)
+          << "node " << v << " at " << x.transpose() << ", slack " << slack;
+      refused += without && !expected;
+      kept_ahead += expected && ahead > 0;
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(kept_ahead, 0);
+}
+
 }  // namespace
 }  // namespace stc
