@@ -63,8 +63,9 @@ struct CutState {
   // The last band's triangles (as inserted, margins included) and its front, the border the
   // next band carries the cut on from; finish_stroke conforms the cut to it (cut_sweep.hpp).
   std::vector<std::array<Vec3, 3>> last_band;
-  std::vector<std::array<Vec3, 2>> last_front;  // segments, each on triangle 2k + 1
-  std::vector<Vec3> last_front_motion;          // per point of the front (tip first): unit, or 0
+  // The front as a polyline, tip first (its segment k lies on triangle 2k + 1 of last_band),
+  // and which way each of its points moved (unit, or 0).
+  std::vector<Vec3> last_front, last_front_motion;
   // The tets the current stroke changed (may repeat): smoothed when the next one begins
   // (cut_smoothing.hpp).
   std::vector<int> stroke_tets;

@@ -56,6 +56,11 @@ void keep_in_stroke(Triangles& stroke, const Triangles& band, bool continues,
   }
 }
 
+// Are a marked face's corners limited ahead of the blade (CutOptions::front_corner_reach)?
+bool limits_ahead(const CutOptions& options) {
+  return options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
+}
+
 long count_marked_face_sides(const TetMesh& mesh) {
   // Four bits per tet, counted by a table of all 256 bytes: __builtin_popcount without a popcnt
   // target is a library call per tet, ~1 ms a cut on the 70k-tet organ (this runs twice per
@@ -267,11 +272,9 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   }
   stop.reach = options.front_corner_reach * margin;
   stop.slack_fraction = options.front_corner_slack;
-  state.last_front_motion = stop.motion;
-  const bool limited = options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
   CutResult result =
       cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none, borders,
-                    kSkinCornerSlack, &marked_in, limited ? &stop : nullptr);
+                    kSkinCornerSlack, &marked_in, limits_ahead(options) ? &stop : nullptr);
   Triangles swept;
   for (size_t i = 0; i + 1 < from.size(); ++i) {
     swept.push_back({from[i], from[i + 1], to[i + 1]});
@@ -282,19 +285,17 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   keep_in_stroke(state.last_sweep, sweep, continues, &state.last_sweep_bands);
   state.last_sweep_end = {to.front(), to.back()};
   state.last_band = sweep;
-  state.last_front.clear();
   // Where the blade's edge is (the margin ahead of it is for the next band): the cut ends there.
-  const std::vector<Vec3> front = extend_ends(to);
-  for (size_t i = 0; i + 1 < front.size(); ++i)
-    state.last_front.push_back({front[i], front[i + 1]});
+  state.last_front = std::move(stop.line);
+  state.last_front_motion = std::move(stop.motion);
   return result;
 }
 
 CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& options) {
   if (state.last_band.empty()) return {};
   std::vector<CutBorder> front;
-  for (size_t i = 0; i < state.last_front.size(); ++i)
-    front.push_back({static_cast<int>(2 * i + 1), state.last_front[i][0], state.last_front[i][1]});
+  for (size_t i = 0; i + 1 < state.last_front.size(); ++i)
+    front.push_back({static_cast<int>(2 * i + 1), state.last_front[i], state.last_front[i + 1]});
   const std::vector<std::array<Vec3, 3>> band = std::move(state.last_band);
   state.last_band.clear();
   // The band's own triangles again: its tets are split already, so only the front's are new.
@@ -304,15 +305,11 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   // Nor may a face reach past the front by more than its corners' slack (CutOptions::
   // front_corner_reach): the front is conformed now, a face beyond it would stay open.
   BladeStop stop;
-  for (const auto& segment : state.last_front) {
-    if (stop.line.empty()) stop.line.push_back(segment[0]);
-    stop.line.push_back(segment[1]);
-  }
+  stop.line = state.last_front;
   stop.motion = state.last_front_motion;
   stop.slack_fraction = 1;
-  const bool limited = options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
   CutResult result = cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0,
-                                   nullptr, limited ? &stop : nullptr);
+                                   nullptr, limits_ahead(options) ? &stop : nullptr);
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);

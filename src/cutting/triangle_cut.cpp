@@ -200,7 +200,7 @@ double StrokeSurface::ahead_of_stop(const Vec3& x) const {
     const double distance = (x - at).norm();
     if (distance >= nearest) continue;
     nearest = distance;
-    Vec3 motion = (1 - u) * stop_motion_[i] + u * stop_motion_[i + 1];
+    const Vec3 motion = (1 - u) * stop_motion_[i] + u * stop_motion_[i + 1];
     ahead = motion.norm() > 0 ? (x - at).dot(motion.normalized()) : -1;
   }
   return ahead;
@@ -208,14 +208,17 @@ double StrokeSurface::ahead_of_stop(const Vec3& x) const {
 
 bool StrokeSurface::corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
                                 double skin_slack) {
-  if (stop_.size() >= 2 &&
-      ahead_of_stop(mesh.nodes[v]) > stop_reach_ + stop_slack_fraction_ * slack)
-    return false;
-  if (near_node(mesh, v, slack)) return true;
-  if (!near_node(mesh, v, skin_slack * slack)) return false;
-  std::int8_t& boundary = known_[v].on_boundary;
-  if (boundary < 0) boundary = on_boundary(mesh, state, v) ? 1 : 0;
-  return boundary != 0;
+  if (!near_node(mesh, v, slack)) {
+    if (!near_node(mesh, v, skin_slack * slack)) return false;
+    std::int8_t& boundary = known_[v].on_boundary;
+    if (boundary < 0) boundary = on_boundary(mesh, state, v) ? 1 : 0;
+    if (!boundary) return false;
+  }
+  if (stop_.size() < 2) return true;
+  // Once per node, as the rest (the mesh does not change while faces are marked).
+  double& ahead = known_[v].ahead;
+  if (std::isnan(ahead)) ahead = ahead_of_stop(mesh.nodes[v]);
+  return ahead <= stop_reach_ + stop_slack_fraction_ * slack;
 }
 
 bool split_too_thin(const TetMesh& mesh, const CutState& state, int t, int a, int b, double s,

@@ -107,7 +107,8 @@ class StrokeSurface {
   // A triangle within near_at (near for every slack >= it); none within far_below.
   struct Known {
     double near_at = std::numeric_limits<double>::infinity(), far_below = -1;
-    std::int8_t on_boundary = -1;  // -1: not asked yet
+    double ahead = std::numeric_limits<double>::quiet_NaN();  // of the stop line; NaN: not asked
+    std::int8_t on_boundary = -1;                             // -1: not asked yet
   };
   std::unordered_map<int, Known> known_;
 };
