@@ -66,6 +66,14 @@ struct CutState {
   // The front as a polyline, tip first (its segment k lies on triangle 2k + 1 of last_band),
   // and which way each of its points moved (unit, or 0).
   std::vector<Vec3> last_front, last_front_motion;
+  // The paths the stroke's tip and heel took (no margin; points kept a little apart, the
+  // newest always) and the way past each point (unit: down the blade past the tip, up past the
+  // heel): a marked face's corner may lie only a little past them (cut_sweep.cpp).
+  std::vector<Vec3> tip_path, tip_past, heel_path, heel_past;
+  double stroke_margin = 0;  // the last band's margin (CutOptions::front_margin)
+  // Faces the stroke's cuts refused only because a corner lay past the blade, tested again
+  // by its later cuts (mark_deferred_faces, triangle_cut.hpp).
+  std::vector<std::array<int, 3>> deferred_faces;
   // The tets the current stroke changed (may repeat): smoothed when the next one begins
   // (cut_smoothing.hpp).
   std::vector<int> stroke_tets;

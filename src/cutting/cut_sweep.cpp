@@ -61,6 +61,40 @@ bool limits_ahead(const CutOptions& options) {
   return options.front_corner_reach >= 0 && options.front_corner_slack >= 0;
 }
 
+// Appends x to a path of the stroke (`way`: past it), or moves the path's last point there when
+// that lies within `spacing` of the one before (the newest point is always kept).
+void extend_path(std::vector<Vec3>& path, std::vector<Vec3>& past, const Vec3& x, const Vec3& way,
+                 double spacing) {
+  if (path.size() >= 2 && (path[path.size() - 2] - x).norm() < spacing) {
+    path.back() = x;
+    past.back() = way;
+    return;
+  }
+  path.push_back(x);
+  past.push_back(way);
+  if (path.size() > kMaxStrokeTriangles) {
+    path.erase(path.begin());
+    past.erase(past.begin());
+  }
+}
+
+// The stroke's tip and heel paths as limits (CutOptions::path_corner_reach), if set.
+void add_path_limits(const CutState& state, const CutOptions& options, double margin,
+                     std::vector<BladeStop>& stops) {
+  if (options.path_corner_reach < 0 || options.path_corner_slack < 0) return;
+  for (const auto* path : {&state.tip_path, &state.heel_path}) {
+    BladeStop stop;
+    stop.line = *path;
+    stop.past = path == &state.tip_path ? state.tip_past : state.heel_past;
+    stop.reach = options.path_corner_reach * margin;
+    stop.slack_fraction = options.path_corner_slack;
+    stops.push_back(std::move(stop));
+  }
+}
+
+// At most this many faces wait (CutState::deferred_faces); the oldest go first.
+constexpr size_t kMaxDeferredFaces = 4096;
+
 long count_marked_face_sides(const TetMesh& mesh) {
   // Four bits per tet, counted by a table of all 256 bytes: __builtin_popcount without a popcnt
   // target is a library call per tet, ~1 ms a cut on the 70k-tet organ (this runs twice per
@@ -137,7 +171,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
                         const CutOptions& options,
                         const std::vector<std::array<Vec3, 3>>& also_mark_in,
                         const std::vector<CutBorder>& borders, double skin_slack,
-                        const std::vector<std::array<Vec3, 3>>* marked_in, const BladeStop* stop) {
+                        const std::vector<std::array<Vec3, 3>>* marked_in,
+                        const std::vector<BladeStop>& stops) {
   CutResult result;
   if (also_mark_in.empty()) {
     // A new stroke: the last one's cut is complete, so its tets' shapes come first (not when it
@@ -148,6 +183,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
     result.nodes_smoothed = static_cast<int>(result.moved_nodes.size());
     state.on_stroke.clear();
     state.on_extension.clear();
+    state.deferred_faces.clear();
   }
   std::set<FaceKey> new_faces;
   const long marked_before = count_marked_face_sides(mesh);
@@ -170,7 +206,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
       split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
                          border.p1, options, stroke, result);
   StrokeSurface marks(surface);
-  if (stop) marks.set_stop(stop->line, stop->motion, stop->reach, stop->slack_fraction);
+  for (const BladeStop& stop : stops)
+    marks.add_limit(stop.line, stop.past, stop.reach, stop.slack_fraction);
   // The mesh no longer changes: every classification shares the nodes' scales.
   NodeScales scales;
   for (auto& tri : cut) {
@@ -184,11 +221,34 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   if (!triangles.empty())
     mark_faces_on_earlier_triangles(mesh, state, marked_in ? *marked_in : also_mark_in, lo, hi,
                                     options, marks, skin_slack, scales, result, new_faces);
+  // Faces earlier cuts refused only for lying past the blade, tested again now that it has
+  // moved on; this cut's own such faces join them (oldest first).
+  std::set<FaceKey> deferred_marked;
+  if (marks.limited()) {
+    std::vector<FaceKey> still =
+        mark_deferred_faces(mesh, state, state.deferred_faces, marks, skin_slack, deferred_marked);
+    std::set<FaceKey> waiting(still.begin(), still.end());
+    for (const FaceKey& key : marks.deferred())
+      if (waiting.insert(key).second) still.push_back(key);
+    if (still.size() > kMaxDeferredFaces)
+      still.erase(still.begin(), still.end() - static_cast<long>(kMaxDeferredFaces));
+    state.deferred_faces = std::move(still);
+  }
   if (!triangles.empty()) {
-    // Marked faces lie inside the triangles' box; their tets overlap it.
+    // Marked faces lie inside the triangles' box (their tets overlap it), or are deferred ones.
     std::vector<int> region;
     for (int t : state.grid.query(mesh, lo, hi))
       if (state.cuttable[t]) region.push_back(t);
+    if (!deferred_marked.empty()) {
+      for (const FaceKey& key : deferred_marked) {
+        new_faces.insert(key);
+        for (int v : key)
+          for (int t : state.node_tets[static_cast<size_t>(v)])
+            if (state.cuttable[t]) region.push_back(t);
+      }
+      std::sort(region.begin(), region.end());
+      region.erase(std::unique(region.begin(), region.end()), region.end());
+    }
     separate_along_cuts(mesh, state, region, result, new_faces);
   }
   settle(mesh, state, result, 0, marked_before);
@@ -263,18 +323,43 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
       continues ? spaced_bands(state.last_sweep, state.last_sweep_bands, kBandSpacing * margin)
                 : none;
   // A face the band opens may reach only a little ahead of the blade's edge (CutOptions::
-  // front_corner_reach), though the tissue is split the whole margin ahead.
+  // front_corner_reach), though the tissue is split the whole margin ahead; nor much below the
+  // tip's path or above the heel's (path_corner_reach), though it is split the margin past
+  // them too.
   BladeStop stop;
   stop.line = extend_ends(to);
   for (size_t i = 0; i < to.size(); ++i) {
     const Vec3 motion = to[i] - from[i];
-    stop.motion.push_back(motion.norm() > 0 ? Vec3(motion.normalized()) : Vec3::Zero());
+    stop.past.push_back(motion.norm() > 0 ? Vec3(motion.normalized()) : Vec3::Zero());
   }
   stop.reach = options.front_corner_reach * margin;
   stop.slack_fraction = options.front_corner_slack;
-  CutResult result =
-      cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none, borders,
-                    kSkinCornerSlack, &marked_in, limits_ahead(options) ? &stop : nullptr);
+  // The tip's and heel's paths as the blade took them (no margin), each point with the way
+  // along the blade past it: down past the tip, up past the heel.
+  if (!continues) {
+    state.tip_path.clear(), state.tip_past.clear();
+    state.heel_path.clear(), state.heel_past.clear();
+  }
+  const auto past_end = [](const Vec3& end, const Vec3& next) {
+    const Vec3 d = end - next;
+    return d.norm() > 0 ? Vec3(d.normalized()) : Vec3::Zero();
+  };
+  const size_t heel = to.size() - 1;
+  if (state.tip_path.empty()) {
+    extend_path(state.tip_path, state.tip_past, from.front(), past_end(from[0], from[1]), 0);
+    extend_path(state.heel_path, state.heel_past, from.back(), past_end(from[heel], from[heel - 1]),
+                0);
+  }
+  const double spacing = kBandSpacing * margin;
+  extend_path(state.tip_path, state.tip_past, to.front(), past_end(to[0], to[1]), spacing);
+  extend_path(state.heel_path, state.heel_past, to.back(), past_end(to[heel], to[heel - 1]),
+              spacing);
+  state.stroke_margin = margin;
+  std::vector<BladeStop> stops;
+  if (limits_ahead(options)) stops.push_back(stop);
+  add_path_limits(state, options, margin, stops);
+  CutResult result = cut_triangles(mesh, state, sweep, options, continues ? state.last_sweep : none,
+                                   borders, kSkinCornerSlack, &marked_in, stops);
   Triangles swept;
   for (size_t i = 0; i + 1 < from.size(); ++i) {
     swept.push_back({from[i], from[i + 1], to[i + 1]});
@@ -287,7 +372,7 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   state.last_band = sweep;
   // Where the blade's edge is (the margin ahead of it is for the next band): the cut ends there.
   state.last_front = std::move(stop.line);
-  state.last_front_motion = std::move(stop.motion);
+  state.last_front_motion = std::move(stop.past);
   return result;
 }
 
@@ -306,10 +391,13 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   // front_corner_reach): the front is conformed now, a face beyond it would stay open.
   BladeStop stop;
   stop.line = state.last_front;
-  stop.motion = state.last_front_motion;
+  stop.past = state.last_front_motion;
   stop.slack_fraction = 1;
-  CutResult result = cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0,
-                                   nullptr, limits_ahead(options) ? &stop : nullptr);
+  std::vector<BladeStop> stops;
+  if (limits_ahead(options)) stops.push_back(std::move(stop));
+  add_path_limits(state, options, state.stroke_margin, stops);
+  CutResult result =
+      cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, nullptr, stops);
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);

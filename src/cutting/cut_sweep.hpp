@@ -47,12 +47,13 @@ struct CutBorder {
 // was cut since the last call; the stroke may go on afterwards.
 CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& options = {});
 
-// Where the blade's edge stands, as a limit on how far ahead of it (along its motion) a marked
-// face's corner may lie: reach + slack_fraction x the corner's slack (StrokeSurface::set_stop,
+// Where the blade stands - its edge, or the path its tip or heel took - as a limit on how far
+// past it (ahead of the edge along its motion, below the tip, above the heel) a marked face's
+// corner may lie: reach + slack_fraction x the corner's slack (StrokeSurface::add_limit,
 // CutOptions::front_corner_reach).
 struct BladeStop {
-  std::vector<Vec3> line;    // tip first
-  std::vector<Vec3> motion;  // per point of line: unit, or 0 where it does not move
+  std::vector<Vec3> line;  // tip first along an edge
+  std::vector<Vec3> past;  // per point of line: unit, or 0 where nothing is past it
   double reach = 0;
   double slack_fraction = 0;
 };
@@ -65,11 +66,14 @@ struct BladeStop {
 // skin_slack: as mark_faces_on_triangle's (triangle_cut.hpp).
 // marked_in: the earlier triangles whose faces are marked (default also_mark_in): a slow
 // stroke's bands thinned (cut_band).
-// stop: where the blade's edge stands, if a marked face's corners are limited ahead of it.
-CutResult cut_triangles(
-    TetMesh& mesh, CutState& state, const std::vector<std::array<Vec3, 3>>& triangles,
-    const CutOptions& options = {}, const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
-    const std::vector<CutBorder>& borders = {}, double skin_slack = kSkinCornerSlack,
-    const std::vector<std::array<Vec3, 3>>* marked_in = nullptr, const BladeStop* stop = nullptr);
+// stops: where the blade stands, if a marked face's corners are limited past it.
+CutResult cut_triangles(TetMesh& mesh, CutState& state,
+                        const std::vector<std::array<Vec3, 3>>& triangles,
+                        const CutOptions& options = {},
+                        const std::vector<std::array<Vec3, 3>>& also_mark_in = {},
+                        const std::vector<CutBorder>& borders = {},
+                        double skin_slack = kSkinCornerSlack,
+                        const std::vector<std::array<Vec3, 3>>* marked_in = nullptr,
+                        const std::vector<BladeStop>& stops = {});
 
 }  // namespace stc

@@ -181,44 +181,47 @@ bool StrokeSurface::near_node(const TetMesh& mesh, int v, double slack) {
   return false;
 }
 
-void StrokeSurface::set_stop(std::vector<Vec3> line, std::vector<Vec3> motion, double reach,
-                             double slack_fraction) {
-  stop_ = std::move(line);
-  stop_motion_ = std::move(motion);
-  stop_reach_ = reach;
-  stop_slack_fraction_ = slack_fraction;
-  if (stop_motion_.size() != stop_.size()) stop_.clear();
+void StrokeSurface::add_limit(std::vector<Vec3> line, std::vector<Vec3> past, double reach,
+                              double slack_fraction) {
+  if (line.empty() || past.size() != line.size() || limits_.size() == kMaxLimits) return;
+  limits_.push_back({std::move(line), std::move(past), reach, slack_fraction});
 }
 
-double StrokeSurface::ahead_of_stop(const Vec3& x) const {
-  double nearest = std::numeric_limits<double>::infinity(), ahead = -1;
-  for (size_t i = 0; i + 1 < stop_.size(); ++i) {
-    const Vec3 d = stop_[i + 1] - stop_[i];
+double StrokeSurface::Limit::past_of(const Vec3& x) const {
+  double nearest = std::numeric_limits<double>::infinity(), beyond = -1;
+  for (size_t i = 0; i < line.size(); ++i) {
+    // Segment i (a single point where the line has one).
+    const size_t j = std::min(i + 1, line.size() - 1);
+    if (j == i && line.size() > 1) break;
+    const Vec3 d = line[j] - line[i];
     const double u =
-        d.squaredNorm() > 0 ? std::clamp((x - stop_[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
-    const Vec3 at = stop_[i] + u * d;
+        d.squaredNorm() > 0 ? std::clamp((x - line[i]).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+    const Vec3 at = line[i] + u * d;
     const double distance = (x - at).norm();
     if (distance >= nearest) continue;
     nearest = distance;
-    const Vec3 motion = (1 - u) * stop_motion_[i] + u * stop_motion_[i + 1];
-    ahead = motion.norm() > 0 ? (x - at).dot(motion.normalized()) : -1;
+    const Vec3 way = (1 - u) * past[i] + u * past[j];
+    beyond = way.norm() > 0 ? (x - at).dot(way.normalized()) : -1;
   }
-  return ahead;
+  return beyond;
 }
 
 bool StrokeSurface::corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
-                                double skin_slack) {
+                                double skin_slack, bool with_limits) {
   if (!near_node(mesh, v, slack)) {
     if (!near_node(mesh, v, skin_slack * slack)) return false;
     std::int8_t& boundary = known_[v].on_boundary;
     if (boundary < 0) boundary = on_boundary(mesh, state, v) ? 1 : 0;
     if (!boundary) return false;
   }
-  if (stop_.size() < 2) return true;
-  // Once per node, as the rest (the mesh does not change while faces are marked).
-  double& ahead = known_[v].ahead;
-  if (std::isnan(ahead)) ahead = ahead_of_stop(mesh.nodes[v]);
-  return ahead <= stop_reach_ + stop_slack_fraction_ * slack;
+  if (!with_limits) return true;
+  for (size_t k = 0; k < limits_.size(); ++k) {
+    // Once per node, as the rest (the mesh does not change while faces are marked).
+    double& past = known_[v].past[k];
+    if (std::isnan(past)) past = limits_[k].past_of(mesh.nodes[v]);
+    if (past > limits_[k].reach + limits_[k].slack_fraction * slack) return false;
+  }
+  return true;
 }
 
 bool split_too_thin(const TetMesh& mesh, const CutState& state, int t, int a, int b, double s,
@@ -350,14 +353,18 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         const bool outside = !tri.contains(mesh.nodes[u] + s * (mesh.nodes[v] - mesh.nodes[u]),
                                            options.inside_tolerance);
         if (outside && !std::binary_search(whole.begin(), whole.end(), t)) continue;
-        // moved: relocated exactly onto the plane. A node beyond the triangle taken there
-        // (not one snapped in place, up to the snap distance off the plane) is on the
-        // surface's extension for the stroke's later triangles (cut_state.hpp).
+        // moved: relocated exactly onto the plane. A node beyond the triangle taken there is on
+        // the surface's extension for the stroke's later triangles (cut_state.hpp). One snapped
+        // in place (up to the snap distance off the plane) is on the stroke as any snapped node:
+        // otherwise it is "on" for this triangle alone, and a face it shares with nodes inside
+        // the border - one straddling a tilted stroke's start, refused while the blade was short
+        // of its other corners - is never found again (a 3.7 mm hole at the thigh's start). How
+        // far past the border such a face may reach is the corner tests' to say (corner_near).
         auto put_on = [&](int node, bool moved) {
           tri.set_on(node);
-          if (!outside)
+          if (!outside || !moved)
             set_on_stroke(state, node);
-          else if (moved)
+          else
             set_on_extension(state, node);
         };
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
@@ -602,8 +609,15 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
   // breaks through the skin, and the blade's edge carried to rest coordinates outside the
   // tissue is extrapolated (rest_mapping.hpp), so the stroke's surface only approximates
   // where the blade crossed the skin.
-  auto corner_ok = [&](int v) { return surface.corner_near(mesh, state, v, slack, skin_slack); };
-  if (!corner_ok(p) || !corner_ok(q) || !corner_ok(r)) return;
+  auto corner_ok = [&](int v, bool with_limits) {
+    return surface.corner_near(mesh, state, v, slack, skin_slack, with_limits);
+  };
+  if (!corner_ok(p, true) || !corner_ok(q, true) || !corner_ok(r, true)) {
+    // Past the blade only: tested again as it moves on (mark_deferred_faces).
+    if (surface.limited() && corner_ok(p, false) && corner_ok(q, false) && corner_ok(r, false))
+      surface.defer(face_key(tet, f));
+    return;
+  }
   if (!state.cuttable[other]) {  // the blade stops at the condensed part
     result.reached_interface = true;
     return;
@@ -613,6 +627,38 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
   FaceKey key = {p, q, r};
   std::sort(key.begin(), key.end());
   new_faces.insert(key);
+}
+
+std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
+                                         const std::vector<FaceKey>& faces, StrokeSurface& surface,
+                                         double skin_slack, std::set<FaceKey>& new_faces) {
+  std::vector<FaceKey> still;
+  for (const FaceKey& key : faces) {
+    // The tet that still has this face (a later split replaced it otherwise), and its side.
+    int t = -1, f = -1;
+    for (int k : state.node_tets[static_cast<size_t>(key[0])]) {
+      for (int g = 0; g < 4 && f < 0; ++g)
+        if (face_key(mesh.tets[static_cast<size_t>(k)], g) == key) t = k, f = g;
+      if (f >= 0) break;
+    }
+    if (t < 0 || !state.cuttable[static_cast<size_t>(t)] || mesh.is_cut_face(t, f)) continue;
+    const auto [other, other_face] = neighbour_across(mesh, state, t, f);
+    if (other < 0 || !state.cuttable[static_cast<size_t>(other)]) continue;
+    double longest = 0;
+    for (int e = 0; e < 3; ++e)
+      longest = std::max(longest, (mesh.nodes[key[e]] - mesh.nodes[key[(e + 1) % 3]]).norm());
+    const double slack = kOnCutSlack * longest;
+    bool near = true;
+    for (int v : key) near = near && surface.corner_near(mesh, state, v, slack, skin_slack);
+    if (!near) {
+      still.push_back(key);
+      continue;
+    }
+    mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
+    mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
+    new_faces.insert(key);
+  }
+  return still;
 }
 
 }  // namespace stc

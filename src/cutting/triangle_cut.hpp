@@ -84,31 +84,47 @@ class StrokeSurface {
   // the tets do not change while it runs, so whether v is on the boundary (a walk of its
   // star) is found once, and only for nodes near enough for it to matter - it had been asked
   // for every corner of every candidate face, 16 % of an organ cutting step (callgrind).
+  // with_limits false: the triangles' distance alone (add_limit's limits not asked).
   bool corner_near(const TetMesh& mesh, const CutState& state, int v, double slack,
-                   double skin_slack);
-  // Where the blade's edge stands (a polyline, tip first) and which way each of its points
-  // moves (unit): a corner may lie at most `reach` + `slack_fraction` x its slack ahead of it
-  // (corner_near), whatever its distance to the triangles. Without it a corner is limited only
-  // by that distance, which reaches past the blade by the triangles' margin plus the slack.
-  void set_stop(std::vector<Vec3> line, std::vector<Vec3> motion, double reach,
-                double slack_fraction);
+                   double skin_slack, bool with_limits = true);
+  bool limited() const { return !limits_.empty(); }
+  // The faces refused only by a limit (they lie past where the blade is now): the stroke
+  // tests them again as the blade moves on (mark_deferred_faces).
+  void defer(const FaceKey& face) { deferred_.push_back(face); }
+  const std::vector<FaceKey>& deferred() const { return deferred_; }
+  // Where the blade stands as a polyline (its edge, tip first; or the path its tip or heel
+  // took) and which way "past it" is at each of its points (unit: the edge's motion, or down
+  // the blade past the tip, up past the heel; 0 where none): a corner may lie at most `reach` +
+  // `slack_fraction` x its slack past it (corner_near), whatever its distance to the
+  // triangles. Without a limit a corner is limited only by that distance, which reaches past
+  // the blade by the triangles' margin plus the slack. Several limits all hold.
+  void add_limit(std::vector<Vec3> line, std::vector<Vec3> past, double reach,
+                 double slack_fraction);
 
  private:
   // The distance to the first triangle (in order: nearest first) within slack, or -1.
   double first_within(const Vec3& x, double slack) const;
 
-  // How far x lies ahead of the stop line (its nearest point's motion; < 0 behind).
-  double ahead_of_stop(const Vec3& x) const;
+  struct Limit {
+    std::vector<Vec3> line, past;
+    double reach = 0, slack_fraction = 0;
+    // How far x lies past the line (along its nearest point's direction; < 0 short of it).
+    double past_of(const Vec3& x) const;
+  };
+  static constexpr size_t kMaxLimits = 3;  // the edge's front, the tip's path, the heel's
 
   std::vector<std::array<Vec3, 3>> triangles_;
   std::vector<Vec3> lo_, hi_;
-  std::vector<Vec3> stop_, stop_motion_;
-  double stop_reach_ = 0, stop_slack_fraction_ = 0;
+  std::vector<Limit> limits_;
+  std::vector<FaceKey> deferred_;
   // A triangle within near_at (near for every slack >= it); none within far_below.
   struct Known {
     double near_at = std::numeric_limits<double>::infinity(), far_below = -1;
-    double ahead = std::numeric_limits<double>::quiet_NaN();  // of the stop line; NaN: not asked
-    std::int8_t on_boundary = -1;                             // -1: not asked yet
+    // How far past each limit's line (NaN: not asked yet).
+    std::array<double, kMaxLimits> past = {std::numeric_limits<double>::quiet_NaN(),
+                                           std::numeric_limits<double>::quiet_NaN(),
+                                           std::numeric_limits<double>::quiet_NaN()};
+    std::int8_t on_boundary = -1;  // -1: not asked yet
   };
   std::unordered_map<int, Known> known_;
 };
@@ -163,6 +179,17 @@ void mark_faces_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassi
 void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassification& triangle,
                            int t, int f, const CutOptions& options, StrokeSurface& surface,
                            double skin_slack, CutResult& result, std::set<FaceKey>& new_faces);
+
+// Phase 2 for faces an earlier cut of the stroke refused only because a corner lay past the
+// blade (StrokeSurface::defer): each that is still a face between two cuttable tets, and whose
+// corners now pass `surface`'s tests (the blade has moved on), is marked. A corner of such a face
+// may be "on" only for the triangle that refused it - one snapped onto its plane past the
+// stroke's start - so no later triangle's mark phase would find it again (the thigh's tilted
+// strokes and the 50k liver's: a 3.7 mm hole at the start). The others (still refused) are
+// returned; faces that no longer exist are dropped.
+std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
+                                         const std::vector<FaceKey>& faces, StrokeSurface& surface,
+                                         double skin_slack, std::set<FaceKey>& new_faces);
 
 // Would bisecting edge (a, b) of tet t at x_a + s (x_b - x_a) leave a piece under the volume
 // guard or the shape guard (CutOptions::min_volume_fraction, split_min_dihedral_deg), as the

@@ -117,6 +117,14 @@ struct CutOptions {
   // the margin (docs/DESIGN.md section 8, "Mark"). Negative: no limit.
   double front_corner_reach = 0.25;
   double front_corner_slack = 0.25;
+  // The same below the path the blade's tip took and above its heel's, along the blade: each
+  // corner at most path_corner_reach x the front margin plus path_corner_slack x its slack past
+  // them. The band reaches a margin past both, and a corner could lie its slack past that: the
+  // 50k liver's tilted strokes opened faces with a corner 2.15 mm below the tip (1.5 x the
+  // Hausdorff tolerance). A face refused by this limit or the one ahead is tested again as the
+  // blade moves on (docs/DESIGN.md section 8, "Mark"). Negative: no limit.
+  double path_corner_reach = 1.0;
+  double path_corner_slack = 0.25;
 };
 
 struct CutResult {

@@ -10,8 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <memory>
 
 namespace stc {
 namespace {
@@ -200,7 +202,7 @@ TEST(EarlierTriangles, CornerTestIsNearOrOnTheSkinAndNearerAtEveryAskedSlack) {
   EXPECT_GT(near, skin_only);
 }
 
-// The limit ahead of the blade (StrokeSurface::set_stop, CutOptions::front_corner_reach): a
+// The limit ahead of the blade (StrokeSurface::add_limit, CutOptions::front_corner_reach): a
 // corner near the surface is refused when it lies farther ahead of the blade's edge, along its
 // motion, than the reach plus slack_fraction x its slack - skin corners too - and the rest is
 // answered as without the limit. The cube's nodes against its plane z = 0.02 (a grid plane),
@@ -214,8 +216,8 @@ TEST(EarlierTriangles, CornerTestStopsAheadOfTheBlade) {
   const Triangles plane = {{Vec3(-0.01, -0.01, z), Vec3(0.05, -0.01, z), Vec3(0.05, 0.05, z)},
                            {Vec3(-0.01, -0.01, z), Vec3(0.05, 0.05, z), Vec3(-0.01, 0.05, z)}};
   StrokeSurface limited(plane), unlimited(plane);
-  limited.set_stop({Vec3(edge_x, -0.01, z), Vec3(edge_x, 0.05, z)}, {Vec3::UnitX(), Vec3::UnitX()},
-                   reach, fraction);
+  limited.add_limit({Vec3(edge_x, -0.01, z), Vec3(edge_x, 0.05, z)}, {Vec3::UnitX(), Vec3::UnitX()},
+                    reach, fraction);
   int refused = 0, kept_ahead = 0;
   for (const double slack : {1e-4, 4e-3, 2.5e-3}) {
     for (int v = 0; v < mesh.num_nodes(); ++v) {
@@ -231,6 +233,68 @@ TEST(EarlierTriangles, CornerTestStopsAheadOfTheBlade) {
   }
   EXPECT_GT(refused, 0);
   EXPECT_GT(kept_ahead, 0);
+}
+
+// A face refused only by a limit (it lies past where the blade is) is kept (StrokeSurface::
+// defer) and marked once the blade has moved on (mark_deferred_faces); until then it waits, and
+// a face that no longer exists is dropped. The cube's faces in its grid plane z = 0.02 against
+// that plane, the blade's edge along y moving along +x: at x = 0.0005 every face there with a
+// corner at x >= 0.01 is refused; with the edge at x = 0.045 none is.
+TEST(EarlierTriangles, FacesPastTheBladeAreMarkedOnceItHasPassed) {
+  TetMesh mesh = cube();
+  const CutState state = make_cut_state(mesh, {}, {});
+  const double z = 0.02;
+  const Triangles plane = {{Vec3(-0.01, -0.01, z), Vec3(0.05, -0.01, z), Vec3(0.05, 0.05, z)},
+                           {Vec3(-0.01, -0.01, z), Vec3(0.05, 0.05, z), Vec3(-0.01, 0.05, z)}};
+  const CutOptions options;
+  auto edge_at = [&](double x) {
+    auto surface = std::make_unique<StrokeSurface>(plane);
+    surface->add_limit({Vec3(x, -0.01, z), Vec3(x, 0.05, z)}, {Vec3::UnitX(), Vec3::UnitX()}, 0,
+                       0.25);
+    return surface;
+  };
+  // The blade at x = 0.0005: nothing in the plane is marked, its faces wait.
+  const auto short_of_them = edge_at(0.0005);
+  CutResult result;
+  std::set<FaceKey> marked;
+  for (const auto& t : plane) {
+    TriangleClassification tri(t[0], t[1], t[2], options.snap_tolerance);
+    mark_faces_on_triangle(mesh, state, tri, Vec3(-0.01, -0.01, z - 1e-3),
+                           Vec3(0.05, 0.05, z + 1e-3), options, *short_of_them, kSkinCornerSlack,
+                           result, marked);
+  }
+  std::vector<FaceKey> waiting = short_of_them->deferred();
+  std::sort(waiting.begin(), waiting.end());
+  waiting.erase(std::unique(waiting.begin(), waiting.end()), waiting.end());
+  // 4 x 4 cells in the plane, two triangles each, every one with a corner at x >= 0.01.
+  EXPECT_TRUE(marked.empty());
+  ASSERT_EQ(waiting.size(), 32u);
+  for (const FaceKey& key : waiting)
+    for (int v : key) EXPECT_NEAR(mesh.nodes[v].z(), z, 1e-12);
+  // The blade not moved yet: they still wait, nothing is marked.
+  std::set<FaceKey> none;
+  EXPECT_EQ(mark_deferred_faces(mesh, state, waiting, *edge_at(0.0005), kSkinCornerSlack, none),
+            waiting);
+  EXPECT_TRUE(none.empty());
+  // The blade past them all: every one is marked, on both of its sides.
+  const long before = std::count_if(mesh.cut_faces.begin(), mesh.cut_faces.end(),
+                                    [](std::uint8_t bits) { return bits != 0; });
+  std::set<FaceKey> now;
+  EXPECT_TRUE(
+      mark_deferred_faces(mesh, state, waiting, *edge_at(0.045), kSkinCornerSlack, now).empty());
+  EXPECT_EQ(now.size(), waiting.size());
+  long sides = 0;
+  for (std::uint8_t bits : mesh.cut_faces)
+    for (int f = 0; f < 4; ++f) sides += (bits >> f) & 1;
+  EXPECT_EQ(sides, 2 * static_cast<long>(waiting.size()));
+  EXPECT_EQ(before, 0);
+  // Marked already, or no longer a face of the mesh: dropped.
+  std::vector<FaceKey> gone = waiting;
+  gone.push_back({0, 1, 2});  // not a face of the cube's tets
+  std::set<FaceKey> again;
+  EXPECT_TRUE(
+      mark_deferred_faces(mesh, state, gone, *edge_at(0.0005), kSkinCornerSlack, again).empty());
+  EXPECT_TRUE(again.empty());
 }
 
 }  // namespace

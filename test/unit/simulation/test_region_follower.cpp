@@ -406,8 +406,11 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossTheThigh) {
   // conformed borders (docs/DESIGN.md section 8, "Borders") open 109 % of this stroke, with
   // moves awaited 110 % (stop 27); with faces reaching 3/4 of the front margin past the blade
   // (stop 28) 97.5 % against `all`'s 110 %: the moves end and restart strokes, and each end
-  // now opens less past the blade.
-  EXPECT_GE(r.opened, 0.85 * b.opened);
+  // now opens less past the blade. Since a tilted stroke's start and faces past the blade
+  // are found again as it moves on (stop 47) `all` opens 128 % (follow 104 %, largest gaps 4.1
+  // and 6.6 mm, from 9.7 and 7.6): what `all` opens past the swept area is not the mark, so
+  // follow is held to 85 % of it up to that area.
+  EXPECT_GE(r.opened, 0.85 * std::min(b.opened, b.swept));
   EXPECT_GE(r.opened, 0.9 * r.swept);
   EXPECT_LE(r.max_gap, b.max_gap + 0.003);  // no gap at the moves beyond the cutter's own
   EXPECT_LT(r.error_vs_full, 1e-9);
