@@ -634,7 +634,7 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
 }
 
 // The TetGen liver's thin lobe (x > 0.018, y from -0.045 to -0.018, not fixed), a 3 cm ball: a
-// vertical blade slices across the lobe along z at x = 0.025 through its whole (sagging)
+// vertical blade slices across the lobe along z at x = 0.028 through its whole (sagging)
 // thickness, then a second stroke runs 4 cm along the top of the body. The slice cuts pieces
 // free mid-stroke while the region moves on around the blade: every model a move builds must
 // hold them (their nodes out of its first factorization; a piece is free unless fixed nodes
@@ -644,7 +644,9 @@ TEST(FollowRegion, TenCentimetreStrokeAcrossATetGenLiver) {
 // alike); the pieces the slice frees are small (one of 16 nodes at the time of writing) but
 // free all the same. Which slice frees one depends on the cutter's details: at x = 0.018 it
 // freed 1-3-tet pieces until stop 46 limited how far ahead of the blade a face opens
-// (CutOptions::front_corner_reach), and none since.
+// (CutOptions::front_corner_reach), and none since; at x = 0.025 it freed one until stop 47
+// (faces past the blade tested again as it moves on), and of x = 0.018, 0.020, ..., 0.030 only
+// 0.028 frees one since.
 TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   test::TempDir dir;
   const Scene scene = follow_liver_scene(dir, 0.06, Vec3(0.018, -0.07, 0.75));
@@ -652,7 +654,7 @@ TEST(FollowRegion, LiverPiecesCutFreeMidStrokeStayHeldAcrossMoves) {
   {  // Edge up (+y) from below the lobe to above it, blade normal along x: the blade plane
      // holds the z motion; 0.5 mm per step from one side of the lobe to the other.
     const Eigen::Quaterniond q = blade_frame(Vec3::UnitY(), Vec3::UnitX(), -Vec3::UnitZ());
-    const Vec3 from(0.025, -0.07, 0.75), to(0.025, -0.07, 0.792);
+    const Vec3 from(0.028, -0.07, 0.75), to(0.028, -0.07, 0.792);
     test::append_line(lobe, from, from, 1, q);
     test::append_line(lobe, from, to, 84, q);
   }
