@@ -634,6 +634,7 @@ std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
                                          double skin_slack, std::set<FaceKey>& new_faces) {
   std::vector<FaceKey> still;
   for (const FaceKey& key : faces) {
+    if (key[0] < 0 || static_cast<size_t>(key[2]) >= state.node_tets.size()) continue;  // sorted
     // The tet that still has this face (a later split replaced it otherwise), and its side.
     int t = -1, f = -1;
     for (int k : state.node_tets[static_cast<size_t>(key[0])]) {

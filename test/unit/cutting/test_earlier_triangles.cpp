@@ -290,7 +290,8 @@ TEST(EarlierTriangles, FacesPastTheBladeAreMarkedOnceItHasPassed) {
   EXPECT_EQ(before, 0);
   // Marked already, or no longer a face of the mesh: dropped.
   std::vector<FaceKey> gone = waiting;
-  gone.push_back({0, 1, 2});  // not a face of the cube's tets
+  gone.push_back({0, 1, 2});                     // not a face of the cube's tets
+  gone.push_back({0, 1, mesh.num_nodes() + 5});  // not a node (a stale key): no crash
   std::set<FaceKey> again;
   EXPECT_TRUE(
       mark_deferred_faces(mesh, state, gone, *edge_at(0.0005), kSkinCornerSlack, again).empty());
