@@ -72,7 +72,7 @@ void extend_path(std::vector<Vec3>& path, std::vector<Vec3>& past, const Vec3& x
   }
   path.push_back(x);
   past.push_back(way);
-  if (path.size() > kMaxStrokeTriangles) {
+  if (path.size() > kMaxStrokeTriangles) {  // as long as the stroke's kept triangles reach
     path.erase(path.begin());
     past.erase(past.begin());
   }

@@ -13,6 +13,14 @@
 namespace stc {
 namespace {
 
+// Face f of tet t, and its side in the tet across it, marked on the cut (both tets get its bit).
+void mark_cut_face(TetMesh& mesh, int t, int f, int other, int other_face,
+                   std::set<FaceKey>& new_faces) {
+  mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
+  mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
+  new_faces.insert(face_key(mesh.tets[static_cast<size_t>(t)], f));
+}
+
 // A crossing this near an end of its edge (a fraction of the edge) puts that end on the cut
 // as it is: it is not moved there.
 constexpr double kNegligibleMove = 1e-3;
@@ -622,11 +630,7 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
     result.reached_interface = true;
     return;
   }
-  mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
-  mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
-  FaceKey key = {p, q, r};
-  std::sort(key.begin(), key.end());
-  new_faces.insert(key);
+  mark_cut_face(mesh, t, f, other, other_face, new_faces);
 }
 
 std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
@@ -655,9 +659,7 @@ std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
       still.push_back(key);
       continue;
     }
-    mesh.cut_faces[t] |= static_cast<std::uint8_t>(1u << f);
-    mesh.cut_faces[other] |= static_cast<std::uint8_t>(1u << other_face);
-    new_faces.insert(key);
+    mark_cut_face(mesh, t, f, other, other_face, new_faces);
   }
   return still;
 }
