@@ -204,7 +204,7 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   for (const CutBorder& border : borders)
     if (border.triangle >= 0 && static_cast<size_t>(border.triangle) < cut.size())
       split_along_border(mesh, state, cut[static_cast<size_t>(border.triangle)], border.p0,
-                         border.p1, options, stroke, result);
+                         border.p1, options, stroke, result, border.tip_path);
   StrokeSurface marks(surface);
   for (const BladeStop& stop : stops)
     marks.add_limit(stop.line, stop.past, stop.reach, stop.slack_fraction);
@@ -315,7 +315,7 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   const Vec3 now[2] = {b.front(), b.back()};
   const int tri[2] = {1, static_cast<int>(sweep.size()) - 2};
   for (int e = 0; e < 2; ++e) {
-    borders.push_back({tri[e], state.border_from[e], now[e]});
+    borders.push_back({tri[e], state.border_from[e], now[e], e == 0});  // e = 0: the tip's
     state.border_from[e] = now[e];
   }
   const std::vector<std::array<Vec3, 3>> none;

@@ -39,6 +39,7 @@ std::vector<std::array<Vec3, 3>> spaced_bands(const std::vector<std::array<Vec3,
 struct CutBorder {
   int triangle = 0;
   Vec3 p0, p1;
+  bool tip_path = false;  // a piece of the path the blade's tip took (CutOptions::path_border_snap)
 };
 
 // The end of a stroke (the blade stops, leaves the tissue, or stops cutting): the cut is

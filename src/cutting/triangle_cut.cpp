@@ -433,7 +433,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 
 void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& tri, const Vec3& p0,
                         const Vec3& p1, const CutOptions& options, const StrokeSurface& surface,
-                        CutResult& result) {
+                        CutResult& result, bool tip_path) {
   if (tri.degenerate()) return;
   const Vec3 along = p1 - p0;
   const double length2 = along.squaredNorm();
@@ -488,11 +488,14 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   // (b) The edges on the cut that cross the segment. An end on the surface's extension past
   // a border is on it as a node on the stroke is: within the snap distance of this triangle's
   // plane (a curved stroke's earlier triangle, at a slight angle to this one, took it there).
+  // Along the tip's path, a node near the plane is taken as on it too
+  // (CutOptions::path_border_snap: between a curved stroke's bands it is on neither).
   auto on_cut_or_extension = [&](int v) {
     if (tri.side(mesh, state, v) == 0) return true;
-    return is_on_extension(state, v) &&
-           std::abs(tri.distance(mesh, v)) <=
-               options.snap_tolerance * star_longest_edge(mesh, state, v);
+    const double d = std::abs(tri.distance(mesh, v));
+    const double snap = options.snap_tolerance * star_longest_edge(mesh, state, v);
+    return (tip_path && d <= options.path_border_snap * snap) ||
+           (is_on_extension(state, v) && d <= snap);
   };
   const std::vector<int> candidates =
       cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);

@@ -157,9 +157,11 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
 // only where its crossings on the sweep's side of the border lie on that surface, or the
 // surface is flat across the tet (a curved or tilted stroke's surface turns away from one
 // triangle's plane across a large tet; a straight one's may just end inside it).
+// tip_path: the segment is a piece of the path the tip took; an edge end within
+// CutOptions::path_border_snap of the snap distance from the plane then counts as on the cut.
 void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& triangle,
                         const Vec3& p0, const Vec3& p1, const CutOptions& options,
-                        const StrokeSurface& surface, CutResult& result);
+                        const StrokeSurface& surface, CutResult& result, bool tip_path = false);
 
 // Phase 2. Marks interior faces between two cuttable tets with three "on" nodes, the tets'
 // fourth nodes on opposite sides and the centroid inside the triangle, among the tets that

@@ -125,6 +125,14 @@ struct CutOptions {
   // blade moves on (docs/DESIGN.md section 8, "Mark"). Negative: no limit.
   double path_corner_reach = 1.0;
   double path_corner_slack = 0.25;
+  // Where the band is conformed along the tip's path (eq. (19a)), an edge with an end this
+  // fraction of the snap distance (snap_tolerance x its star's longest edge) off the band's
+  // plane counts as on the cut, as one from a node on it: on a curved stroke such a node lies
+  // between the bands' planes, is "on" none of them, and the edges from it were left whole - a
+  // hole above the tip's path (2.8 mm, 1.7 x the Hausdorff tolerance, on the 36k liver's curved
+  // tilted slow stroke). Not along the heel's path (no stroke of the fidelity matrix gains; the
+  // coarse liver's belly cut opens 152 % of its sweep). docs/DESIGN.md section 8 "Borders". 0: off.
+  double path_border_snap = 0.75;
 };
 
 struct CutResult {
