@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 #include <sstream>
 
@@ -347,24 +348,39 @@ TEST(CutFidelity, OpeningClosedMarksAtAStrokesEnd) {
   EXPECT_GE(with.f.opening(), without.f.opening()) << with.line << "\n" << without.line;
 }
 
+// One stroke on a fresh copy of `mesh` with the cutter's options as they are and again with
+// `turn_off` applied to them: what an option does, measured on the same stroke.
+struct OnAndOff {
+  Figures on, off;
+  Stroke stroke;
+};
+OnAndOff on_and_off(const std::string& mesh, double tilt, double step, bool curved,
+                    const std::function<void(CutOptions&)>& turn_off, const char* on_label,
+                    const char* off_label) {
+  OnAndOff r;
+  for (const bool on : {true, false}) {
+    auto b = make_bench(mesh);
+    if (!on) turn_off(b->options);
+    r.stroke = variant(b->stroke, tilt, step, curved);
+    const Figures fig = run_stroke(*b, r.stroke, on ? on_label : off_label);
+    EXPECT_TRUE(fig.violated.empty()) << fig.line;
+    (on ? r.on : r.off) = fig;
+  }
+  return r;
+}
+
 // CutOptions::front_corner_reach: a face the band opens reaches little ahead of the blade's
 // edge, so none is left open past where the blade stops. The fine liver2's straight vertical
 // 3 mm stroke: without the limit a face with a corner 1.19 mm past the blade's last position
 // stays open (measured 1.32 x the tolerance), with it 0.92 x; over the 40 strokes of the matrix
 // 22 -> 30 within the tolerance, the least opening 95.5 -> 95.9 %.
 TEST(CutFidelity, FacesStopWhereTheBladeStops) {
-  Figures limited, unlimited;
-  for (const bool limit : {true, false}) {
-    auto b = make_bench("liver2-50000");
-    if (!limit) b->options.front_corner_reach = -1;
-    const Figures fig = run_stroke(*b, variant(b->stroke, 0, 3e-3, false),
-                                   limit ? "faces limited ahead" : "faces not limited ahead");
-    EXPECT_TRUE(fig.violated.empty()) << fig.line;
-    (limit ? limited : unlimited) = fig;
-  }
-  EXPECT_LE(limited.f.faces_over_tolerance, 1.0) << limited.line;
-  EXPECT_GT(unlimited.f.faces_over_tolerance, 1.2) << unlimited.line;
-  EXPECT_GE(limited.f.opening(), 0.9) << limited.line;
+  const OnAndOff r = on_and_off(
+      "liver2-50000", 0, 3e-3, false, [](CutOptions& o) { o.front_corner_reach = -1; },
+      "faces limited ahead", "faces not limited ahead");
+  EXPECT_LE(r.on.f.faces_over_tolerance, 1.0) << r.on.line;
+  EXPECT_GT(r.off.f.faces_over_tolerance, 1.2) << r.off.line;
+  EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
 }
 
 // CutOptions::path_corner_reach: a face the band opens reaches little below the path the tip
@@ -373,18 +389,11 @@ TEST(CutFidelity, FacesStopWhereTheBladeStops) {
 // (1.18 x the tolerance), with it 0.94 x; over the 40 strokes of the matrix (with the faces
 // tested again as the blade moves on) 30 -> 33 within the tolerance.
 TEST(CutFidelity, FacesStopAtTheTipsPath) {
-  Figures limited, unlimited;
-  for (const bool limit : {true, false}) {
-    auto b = make_bench("liver-50000");
-    if (!limit) b->options.path_corner_reach = -1;
-    const Figures fig =
-        run_stroke(*b, variant(b->stroke, 45, 3e-3, false),
-                   limit ? "faces limited at the tip" : "faces not limited at the tip");
-    EXPECT_TRUE(fig.violated.empty()) << fig.line;
-    (limit ? limited : unlimited) = fig;
-  }
-  expect_issue_targets(limited, variant(make_bench("liver-50000")->stroke, 45, 3e-3, false));
-  EXPECT_GT(unlimited.f.faces_over_tolerance, 1.1) << unlimited.line;
+  const OnAndOff r = on_and_off(
+      "liver-50000", 45, 3e-3, false, [](CutOptions& o) { o.path_corner_reach = -1; },
+      "faces limited at the tip", "faces not limited at the tip");
+  expect_issue_targets(r.on, r.stroke);
+  EXPECT_GT(r.off.f.faces_over_tolerance, 1.1) << r.off.line;
 }
 
 // CutOptions::path_border_snap: along the tip's path a curved stroke's band is conformed
@@ -394,18 +403,11 @@ TEST(CutFidelity, FacesStopAtTheTipsPath) {
 // across at the tip's path), 0.73 x with; over the 40 strokes of the matrix 33 -> 34 within the
 // tolerance, the summed excess 2.33 -> 1.87, the worst stroke 1.71 -> 1.53 x (stop 48).
 TEST(CutFidelity, CurvedStrokesConformAlongTheTipsPath) {
-  Figures snapped, plain;
-  for (const bool snap : {true, false}) {
-    auto b = make_bench("liver2-50000");
-    if (!snap) b->options.path_border_snap = 0;
-    const Figures fig =
-        run_stroke(*b, variant(b->stroke, 0, 3e-3, true),
-                   snap ? "path border with near nodes" : "path border without near nodes");
-    EXPECT_TRUE(fig.violated.empty()) << fig.line;
-    (snap ? snapped : plain) = fig;
-  }
-  expect_issue_targets(snapped, variant(make_bench("liver2-50000")->stroke, 0, 3e-3, true));
-  EXPECT_GT(plain.f.hausdorff_over_tolerance, 1.1) << plain.line;
+  const OnAndOff r = on_and_off(
+      "liver2-50000", 0, 3e-3, true, [](CutOptions& o) { o.path_border_snap = 0; },
+      "path border with near nodes", "path border without near nodes");
+  expect_issue_targets(r.on, r.stroke);
+  EXPECT_GT(r.off.f.hausdorff_over_tolerance, 1.1) << r.off.line;
 }
 
 // A tilted blade's stroke opens from where it starts: the faces that straddle its start are
