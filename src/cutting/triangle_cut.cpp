@@ -492,10 +492,11 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   // (CutOptions::path_border_snap: between a curved stroke's bands it is on neither).
   auto on_cut_or_extension = [&](int v) {
     if (tri.side(mesh, state, v) == 0) return true;
+    const bool extension = is_on_extension(state, v);
+    if (!tip_path && !extension) return false;  // no rule applies: the star is not measured
     const double d = std::abs(tri.distance(mesh, v));
     const double snap = options.snap_tolerance * star_longest_edge(mesh, state, v);
-    return (tip_path && d <= options.path_border_snap * snap) ||
-           (is_on_extension(state, v) && d <= snap);
+    return (tip_path && d <= options.path_border_snap * snap) || (extension && d <= snap);
   };
   const std::vector<int> candidates =
       cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
