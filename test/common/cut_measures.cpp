@@ -4,6 +4,9 @@
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
 
 namespace stc::test {
 
@@ -33,6 +36,28 @@ TetShapes tet_shapes(const TetMesh& mesh, const std::vector<std::uint8_t>& selec
 
 int thin_tets(const TetMesh& mesh, double below_deg) {
   return tet_shapes(mesh, {}, below_deg).thin;
+}
+
+int sharp_wedges(const TetMesh& mesh, double below_deg) {
+  std::map<std::pair<int, int>, double> angle;  // per edge (ascending node ids), in degrees
+  for (const Tet& e : mesh.tets)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        int k = -1, l = -1;
+        for (int q = 0; q < 4; ++q)
+          if (q != i && q != j) (k < 0 ? k : l) = q;
+        // The angle at edge ij between faces ijk and ijl: their directions off the edge.
+        const Vec3 &a = mesh.nodes[e[i]], &b = mesh.nodes[e[j]];
+        const Vec3 along = (b - a).normalized();
+        Vec3 u = mesh.nodes[e[k]] - a, v = mesh.nodes[e[l]] - a;
+        u -= u.dot(along) * along;
+        v -= v.dot(along) * along;
+        const double c = std::clamp(u.normalized().dot(v.normalized()), -1.0, 1.0);
+        angle[{std::min(e[i], e[j]), std::max(e[i], e[j])}] += std::acos(c) * 180 / M_PI;
+      }
+  int sharp = 0;
+  for (const auto& [edge, sum] : angle) sharp += sum < below_deg;
+  return sharp;
 }
 
 int closed_cut_faces(const TetMesh& mesh) {

@@ -29,6 +29,13 @@ struct TetShapes {
 TetShapes tet_shapes(const TetMesh& mesh, const std::vector<std::uint8_t>& selected = {},
                      double below_deg = 5.0);
 
+// Wedges of tissue sharper than `below_deg` degrees: edges whose tets' dihedral angles at the
+// edge sum to less than that (a boundary edge where two cut walls, or a wall and the skin, meet
+// at that angle; an interior edge's sum is 360 deg). The tets around such an edge share that
+// angle between them, so no remeshing of the surface as it is lifts them above it: only a cut
+// that does not make the wedge (docs/DESIGN.md section 8, "Where bisection stops").
+int sharp_wedges(const TetMesh& mesh, double below_deg = 5.0);
+
 // The hybrid matrix without the rows and columns of the DOFs of held nodes (`held_node`: one
 // flag per mesh node; the nodes of free pieces): the block that must stay SPD after a cut.
 SparseMatrix free_block(const HybridModel& model, const std::vector<std::uint8_t>& held_node);

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <sstream>
@@ -225,8 +226,12 @@ enum class Targets { kFloors, kIssue };
 // issue's own targets (expect_issue_targets) on the meshes where every stroke meets them -
 // README lists the rest. Every stroke keeps the shape guard's promise (the default 1 deg
 // included); a guard above the default is measured against floors of its own.
-void measure_matrix(const std::string& mesh_name, const CutOptions& options = {},
+// STC_FIDELITY_GUARD=DEG runs every matrix with that shape guard (what a guard costs, stroke
+// by stroke).
+void measure_matrix(const std::string& mesh_name, CutOptions options = {},
                     Targets targets = Targets::kFloors) {
+  if (const char* guard = std::getenv("STC_FIDELITY_GUARD"))
+    options.split_min_dihedral_deg = std::atof(guard);
   const bool strong_guard = options.split_min_dihedral_deg > CutOptions{}.split_min_dihedral_deg;
   for (bool curved : {false, true})
     for (double tilt : {0.0, 45.0})
