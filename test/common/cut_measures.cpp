@@ -4,7 +4,7 @@
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
-#include <cmath>
+#include <array>
 #include <map>
 #include <utility>
 
@@ -40,21 +40,20 @@ int thin_tets(const TetMesh& mesh, double below_deg) {
 
 int sharp_wedges(const TetMesh& mesh, double below_deg) {
   std::map<std::pair<int, int>, double> angle;  // per edge (ascending node ids), in degrees
-  for (const Tet& e : mesh.tets)
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        int k = -1, l = -1;
-        for (int q = 0; q < 4; ++q)
-          if (q != i && q != j) (k < 0 ? k : l) = q;
-        // The angle at edge ij between faces ijk and ijl: their directions off the edge.
-        const Vec3 &a = mesh.nodes[e[i]], &b = mesh.nodes[e[j]];
-        const Vec3 along = (b - a).normalized();
-        Vec3 u = mesh.nodes[e[k]] - a, v = mesh.nodes[e[l]] - a;
-        u -= u.dot(along) * along;
-        v -= v.dot(along) * along;
-        const double c = std::clamp(u.normalized().dot(v.normalized()), -1.0, 1.0);
-        angle[{std::min(e[i], e[j]), std::max(e[i], e[j])}] += std::acos(c) * 180 / M_PI;
+  for (const Tet& e : mesh.tets) {
+    const std::array<double, 6> at =
+        dihedral_angles_deg(mesh.nodes[e[0]], mesh.nodes[e[1]], mesh.nodes[e[2]], mesh.nodes[e[3]]);
+    // Angle k is between faces f < g (face f opposite corner f), in the order (0,1), (0,2),
+    // (0,3), (1,2), (1,3), (2,3): at the edge joining the two other corners.
+    int k = 0;
+    for (int f = 0; f < 4; ++f)
+      for (int g = f + 1; g < 4; ++g, ++k) {
+        int i = -1, j = -1;
+        for (int c = 0; c < 4; ++c)
+          if (c != f && c != g) (i < 0 ? i : j) = c;
+        angle[{std::min(e[i], e[j]), std::max(e[i], e[j])}] += at[static_cast<size_t>(k)];
       }
+  }
   int sharp = 0;
   for (const auto& [edge, sum] : angle) sharp += sum < below_deg;
   return sharp;
