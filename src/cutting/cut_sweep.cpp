@@ -226,7 +226,8 @@ CutResult cut_triangles(TetMesh& mesh, CutState& state,
   std::set<FaceKey> deferred_marked;
   if (marks.limited()) {
     std::vector<FaceKey> still =
-        mark_deferred_faces(mesh, state, state.deferred_faces, marks, skin_slack, deferred_marked);
+        mark_deferred_faces(mesh, state, state.deferred_faces, marks, skin_slack, deferred_marked,
+                            options.wedge_min_deg);
     std::set<FaceKey> waiting(still.begin(), still.end());
     for (const FaceKey& key : marks.deferred())
       if (waiting.insert(key).second) still.push_back(key);

@@ -21,6 +21,26 @@ void mark_cut_face(TetMesh& mesh, int t, int f, int other, int other_face,
   new_faces.insert(face_key(mesh.tets[static_cast<size_t>(t)], f));
 }
 
+// Would opening face f of tet t leave t with two faces on the tissue's surface - f and one
+// already on its boundary (skin, an opened wall) or marked - meeting at under `limit` degrees
+// at their common edge (CutOptions::wedge_min_deg)? Such a tet is a flap of tissue no later
+// repair can thicken: every tet around that edge shares its angle (docs/DESIGN.md section 8,
+// "Where bisection stops" (d)). It stays joined across f instead; the cut then runs along its
+// other face, within the flap's thickness of the blade.
+bool leaves_wedge(const TetMesh& mesh, const CutState& state, int t, int f, double limit) {
+  if (!(limit > 0)) return false;
+  const Tet& k = mesh.tets[static_cast<size_t>(t)];
+  // Angle i is between faces (0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3) (quality.cpp).
+  const std::array<double, 6> angles =
+      dihedral_angles_deg(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]], mesh.nodes[k[3]]);
+  constexpr int kPair[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
+  for (int g = 0; g < 4; ++g) {
+    if (g == f || !(angles[static_cast<size_t>(kPair[f][g])] < limit)) continue;
+    if (mesh.is_cut_face(t, g) || neighbour_across(mesh, state, t, g).first < 0) return true;
+  }
+  return false;
+}
+
 // A crossing this near an end of its edge (a fraction of the edge) puts that end on the cut
 // as it is: it is not moved there.
 constexpr double kNegligibleMove = 1e-3;
@@ -634,12 +654,16 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
     result.reached_interface = true;
     return;
   }
+  if (leaves_wedge(mesh, state, t, f, options.wedge_min_deg) ||
+      leaves_wedge(mesh, state, other, other_face, options.wedge_min_deg))
+    return;
   mark_cut_face(mesh, t, f, other, other_face, new_faces);
 }
 
 std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
                                          const std::vector<FaceKey>& faces, StrokeSurface& surface,
-                                         double skin_slack, std::set<FaceKey>& new_faces) {
+                                         double skin_slack, std::set<FaceKey>& new_faces,
+                                         double wedge_min_deg) {
   std::vector<FaceKey> still;
   for (const FaceKey& key : faces) {
     if (key[0] < 0 || static_cast<size_t>(key[2]) >= state.node_tets.size()) continue;  // sorted
@@ -663,6 +687,9 @@ std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
       still.push_back(key);
       continue;
     }
+    if (leaves_wedge(mesh, state, t, f, wedge_min_deg) ||
+        leaves_wedge(mesh, state, other, other_face, wedge_min_deg))
+      continue;
     mark_cut_face(mesh, t, f, other, other_face, new_faces);
   }
   return still;

@@ -191,7 +191,8 @@ void mark_face_on_triangle(TetMesh& mesh, const CutState& state, TriangleClassif
 // returned; faces that no longer exist are dropped.
 std::vector<FaceKey> mark_deferred_faces(TetMesh& mesh, const CutState& state,
                                          const std::vector<FaceKey>& faces, StrokeSurface& surface,
-                                         double skin_slack, std::set<FaceKey>& new_faces);
+                                         double skin_slack, std::set<FaceKey>& new_faces,
+                                         double wedge_min_deg = CutOptions{}.wedge_min_deg);
 
 // Would bisecting edge (a, b) of tet t at x_a + s (x_b - x_a) leave a piece under the volume
 // guard or the shape guard (CutOptions::min_volume_fraction, split_min_dihedral_deg), as the

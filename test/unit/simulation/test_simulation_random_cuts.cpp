@@ -330,7 +330,8 @@ TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
 // same strokes without it leave 136-152 tets under 5 deg, 0.55-0.68 deg (measured, seeds
 // 20261123, 1, 2; asserted here for seed 1: the guard is what keeps the angle), and with the
 // default 1 deg the angle stays >= 1 deg. Wedges (test::sharp_wedges: walls meeting under
-// 5 deg, which no repair lifts): none with the guard, 7 without it or at 1 deg (seed 1).
+// 5 deg, which no repair lifts): none at any guard since flaps are kept joined (stop 50,
+// CutOptions::wedge_min_deg), 7 at 1 deg without that (seed 1).
 TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   const Scene scene = fidelity::sagging_liver();
   const Vec3 centre = scene.operation_region.sphere.center;
@@ -370,7 +371,8 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
         seed, cuts, sim.counts().tets, operation_min_dihedral(sim), floor, thin_operation_tets(sim),
         wedges);
     EXPECT_GT(cuts, 30) << "seed " << seed;
-    // Where a split would make a wedge of tissue under 5 deg the guard snaps instead.
+    // Where a split would make a wedge of tissue under 5 deg the guard snaps instead (and a
+    // flap is kept joined, CutOptions::wedge_min_deg).
     EXPECT_EQ(wedges, 0) << "seed " << seed;
   }
   {
@@ -388,11 +390,14 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   }
   // Without it, and with the default 1 deg, the same first seed: the thin tets a 5 deg guard
   // prevents, and the floor the default keeps (the lowest after any stroke: the smoothing and
-  // flips of later strokes may raise the last one).
-  for (const double guard : {0.0, 1.0}) {
+  // flips of later strokes may raise the last one). Last, the default guard with nothing to
+  // keep flaps joined (CutOptions::wedge_min_deg = 0): the wedges that option prevents.
+  for (const double guard : {0.0, 1.0, -1.0}) {
     Scene plain_scene = scene;
-    plain_scene.scalpel.shape_guard_deg = guard;
-    Simulation plain(plain_scene);
+    plain_scene.scalpel.shape_guard_deg = guard < 0 ? 1.0 : guard;
+    SimulationOptions options;
+    if (guard < 0) options.cut.wedge_min_deg = 0;
+    Simulation plain(plain_scene, options);
     std::mt19937 rng(1u);
     double lowest = 180;
     for (int k = 0; k < 100; ++k) {
@@ -401,18 +406,23 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
     }
     const int wedges = test::sharp_wedges(plain.mesh());
     std::printf(
-        "guard %.0f deg, seed 1: min dihedral %.2f deg (lowest after a stroke %.2f), %d "
+        "guard %.0f deg%s, seed 1: min dihedral %.2f deg (lowest after a stroke %.2f), %d "
         "tets under 5 deg, %d wedges under 5 deg\n",
-        guard, operation_min_dihedral(plain), lowest, thin_operation_tets(plain), wedges);
+        plain_scene.scalpel.shape_guard_deg, guard < 0 ? " (flaps not kept joined)" : "",
+        operation_min_dihedral(plain), lowest, thin_operation_tets(plain), wedges);
     EXPECT_GT(thin_operation_tets(plain), 50) << "guard " << guard;
-    // The cut follows the blade where two walls (or a wall and the skin) meet at under 5 deg:
-    // the tets in that wedge share its angle, so no repair after the stroke can lift them
-    // (measured 7 with the default guard; docs/DESIGN.md section 8 "Where bisection stops").
-    EXPECT_GT(wedges, 0) << "guard " << guard;
+    // Where a stroke's wall meets an earlier wall or the skin at under 5 deg, the tet between
+    // them would become a flap with two surface faces at that angle; no repair after the stroke
+    // can lift it (docs/DESIGN.md section 8 "Where bisection stops" (d)). Kept joined across
+    // one of them, none is left (stop 50; 7 without, as at stop 49).
+    if (guard < 0)
+      EXPECT_GT(wedges, 0);
+    else
+      EXPECT_EQ(wedges, 0) << "guard " << guard;
     EXPECT_LT(operation_min_dihedral(plain), 2.0) << "guard " << guard;
     if (guard > 0) {
       EXPECT_GE(lowest, guard - 1e-6);
-    } else {
+    } else if (guard == 0) {
       EXPECT_LT(lowest, 1.0);
     }
   }
