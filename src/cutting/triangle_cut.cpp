@@ -159,6 +159,53 @@ bool too_thin(const TetMesh& mesh, const CutState& state, int t, const std::vect
   return thinnest < std::min(options.split_min_dihedral_deg, own) - kAngleRoundOffDeg;
 }
 
+// A crossing moved along its edge (Shift::edge, a < b) to parameter `to`; edge.first < 0: none.
+struct Shift {
+  std::pair<int, int> edge{-1, -1};
+  double to = 0;
+};
+
+// Steps of the search for a guard-passing crossing along an edge (CutOptions::split_shift,
+// border_shift are its range).
+constexpr int kShiftSteps = 10;
+
+// The move of one of `splits`' crossings (those of a tet the guards refuse) along its edge, in
+// steps of split_shift / kShiftSteps up to split_shift, after which every tet on that edge
+// passes the guards with the other crossings as they are: the one that leaves its new node
+// nearest the triangle's plane, if nearer than `limit` (where the end snapped instead lies).
+// An edge already moved (`shifted`) is not moved again, so the rounds of split_along_triangle
+// end.
+Shift nearest_shift(const TetMesh& mesh, const CutState& state, const TriangleClassification& tri,
+                    const std::vector<Split>& splits,
+                    const std::map<std::pair<int, int>, double>& crossing,
+                    const std::map<std::pair<int, int>, double>& shifted, double limit,
+                    const CutOptions& options) {
+  Shift best;
+  if (!(options.split_shift > 0)) return best;
+  for (const Split& sp : splits) {
+    if (shifted.count({sp.a, sp.b})) continue;
+    // How far off the plane the new node moves per unit of t.
+    const double rate = std::abs(tri.distance(mesh, sp.a) - tri.distance(mesh, sp.b));
+    const std::vector<int> around = tets_with_edge(state, sp.a, sp.b);
+    for (int i = 1; i <= kShiftSteps; ++i) {
+      const double by = i * options.split_shift / kShiftSteps;
+      if (!(by * rate < limit)) break;
+      bool found = false;
+      for (const double to : {sp.t - by, sp.t + by}) {
+        if (found || to < options.snap_tolerance || to > 1 - options.snap_tolerance) continue;
+        std::map<std::pair<int, int>, double> trial = crossing;
+        trial[{sp.a, sp.b}] = to;
+        found = true;
+        for (int k : around)
+          found = found && !too_thin(mesh, state, k, splits_of(mesh.tets[k], trial), options);
+        if (found) limit = by * rate, best = {{sp.a, sp.b}, to};
+      }
+      if (found) break;
+    }
+  }
+  return best;
+}
+
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no
 // marked face touches, and its star keeps positive volume above the size guard and a smallest
 // dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
@@ -362,6 +409,9 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
   // only removes crossing edges, so the loop ends.
   std::map<std::pair<int, int>, double> crossing;
   std::set<std::pair<int, int>> beyond;  // crossing outside the triangle (`whole` tets)
+  // Crossings the guards refused where they are, moved along their edges (CutOptions::
+  // split_shift): the offset from where the plane crosses, kept across the rounds below.
+  std::map<std::pair<int, int>, double> shifted;
   for (;;) {
     crossing.clear();
     beyond.clear();
@@ -415,7 +465,8 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
           resnap = true;
           continue;
         }
-        crossing[{u, v}] = s;
+        const auto moved = shifted.find({u, v});
+        crossing[{u, v}] = moved == shifted.end() ? s : s + moved->second;
         if (outside) beyond.insert({u, v});
       }
     }
@@ -432,6 +483,16 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         const bool beyond_here = beyond.count({s.a, s.b}) > 0;
         if (s.t < best) best = s.t, nearest = s.a, outside = beyond_here;
         if (1 - s.t < best) best = 1 - s.t, nearest = s.b, outside = beyond_here;
+      }
+      // Or move one crossing along its edge where that puts its new node nearer the plane
+      // than the snapped end lies (docs/DESIGN.md section 8 "Shape guard", eq. (20d)).
+      if (const Shift shift = nearest_shift(mesh, state, tri, splits, crossing, shifted,
+                                            std::abs(tri.distance(mesh, nearest)), options);
+          shift.edge.first >= 0) {
+        shifted[shift.edge] = shift.to - crossing[shift.edge];
+        crossing[shift.edge] = shift.to;
+        snapped = true;  // round again: every tet is checked with the moved crossing
+        continue;
       }
       tri.set_on(nearest);
       if (!outside) set_on_stroke(state, nearest);
@@ -554,6 +615,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   }
   // The volume guard: drop the crossing nearest an end in any tet it would thin too much
   // (such a face is left whole: the border then runs along its nearer edge or vertex).
+  std::map<std::pair<int, int>, double> refused;
   for (bool dropped = true; dropped && !crossing.empty();) {
     dropped = false;
     for (int t : candidates) {
@@ -562,16 +624,35 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
       const Split* worst = &splits.front();
       for (const Split& x : splits)
         if (std::min(x.t, 1 - x.t) < std::min(worst->t, 1 - worst->t)) worst = &x;
+      refused.emplace(std::make_pair(worst->a, worst->b), worst->t);
       crossing.erase({worst->a, worst->b});
       dropped = true;
     }
   }
+  // A refused crossing is moved along its edge instead, to the nearest point the guards allow
+  // (CutOptions::border_shift): the edge lies on the cut, so its new node does too, and only
+  // the border moves - by a fraction of the edge - where dropping it would leave the face
+  // across the border whole, a hole up to an element wide along the tip's path.
+  if (options.border_shift > 0) crossing.insert(refused.begin(), refused.end());
   // Edges the other tets of the candidates' stars share are split there too (bisect_edge
   // splits every tet on the edge), so each such tet must pass the guard as well.
-  for (const auto& [edge, t] : crossing) {
-    bool fits = true;
-    for (int k : tets_with_edge(state, edge.first, edge.second))
-      fits = fits && !too_thin(mesh, state, k, {Split{edge.first, edge.second, t}}, options);
+  for (const auto& entry : crossing) {
+    const std::pair<int, int> edge = entry.first;
+    double t = entry.second;
+    auto fits_at = [&](double s) {
+      for (int k : tets_with_edge(state, edge.first, edge.second))
+        if (too_thin(mesh, state, k, {Split{edge.first, edge.second, s}}, options)) return false;
+      return true;
+    };
+    bool fits = !refused.count(edge) && fits_at(t);
+    if (!fits && options.border_shift > 0) {
+      for (int i = 1; i <= kShiftSteps && !fits; ++i)
+        for (const double s : {t - i * options.border_shift / kShiftSteps,
+                               t + i * options.border_shift / kShiftSteps})
+          if (!fits && s >= options.snap_tolerance && s <= 1 - options.snap_tolerance &&
+              fits_at(s))
+            t = s, fits = true;
+    }
     if (!fits) continue;
     const size_t before = result.changed_tets.size();
     const int m = bisect_edge(mesh, state, edge.first, edge.second, t, result.changed_tets);

@@ -72,7 +72,7 @@ struct ScalpelParams {
   // blade less closely (docs/DESIGN.md section 8, "Shape guard"). Extension of this package.
   // The default, 1 deg, costs no fidelity on the issue 9 stroke matrix; 5 keeps the operation
   // part above 5 deg at a measured cost (docs/SCENE.md). A Simulation takes this value.
-  double shape_guard_deg = 1;
+  double shape_guard_deg = 5;
 };
 
 // A blade pose in the scene frame: origin = blade tip, local +x = cutting edge, local y =

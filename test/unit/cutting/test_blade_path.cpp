@@ -148,8 +148,9 @@ TEST(CutPathSampling, RepeatedCutSaysItIsAlreadyCut) {
   // The same path again can still open a few faces where the first pass snapped (its cut lies
   // up to snap * edge off the blade, and each pass carries the path to rest coordinates
   // through the tissue opened by the last); it settles within a few passes (measured: 3 until
-  // stop 46; 4 since faces past the blade wait for it, 31 / 6 / 2 / 0 faces), and then the
-  // reply names the true reason instead of "does not cross".
+  // stop 46; 4 since faces past the blade wait for it, 31 / 6 / 2 / 0 faces; 5 since the 5 deg
+  // guard moves crossings along their edges, stop 51: 38 / 25 / 4 / 2 / 0), and then the reply
+  // names the true reason instead of "does not cross".
   CutOutcome again;
   int passes = 0;
   do {
@@ -157,8 +158,8 @@ TEST(CutPathSampling, RepeatedCutSaysItIsAlreadyCut) {
     ++passes;
     std::printf("repeat %d: %s, %d cut faces, %d tets split\n", passes, again.message.c_str(),
                 again.cut_faces, again.tets_split);
-  } while (again.success && passes < 5);
-  EXPECT_LE(passes, 4);
+  } while (again.success && passes < 6);
+  EXPECT_LE(passes, 5);
   EXPECT_FALSE(again.success);
   EXPECT_NE(again.message.find("already cut"), std::string::npos) << again.message;
   const CutOutcome miss = sim.cut_along(line(Vec3(0.2, 0, 0), Vec3(0.25, 0, 0), 5));

@@ -418,13 +418,17 @@ TEST(CutFidelity, FacesStopAtTheTipsPath) {
 // neither, and the edges from it were left whole: a hole above the tip's path). The fine
 // liver2's curved vertical 3 mm stroke: 1.21 x the Hausdorff tolerance without (a hole 2.3 mm
 // across at the tip's path), 0.73 x with; over the 40 strokes of the matrix 33 -> 34 within the
-// tolerance, the summed excess 2.33 -> 1.87, the worst stroke 1.71 -> 1.53 x (stop 48).
+// tolerance, the summed excess 2.33 -> 1.87, the worst stroke 1.71 -> 1.53 x (stop 48). Since
+// the 5 deg guard moves refused crossings along their edges (stop 51) that stroke measures
+// 0.99 x either way (its hole is conformed by the border's shifted crossings); the rule must
+// still not cost it.
 TEST(CutFidelity, CurvedStrokesConformAlongTheTipsPath) {
   const OnAndOff r = on_and_off(
       "liver2-50000", 0, 3e-3, true, [](CutOptions& o) { o.path_border_snap = 0; },
       "path border with near nodes", "path border without near nodes");
   expect_issue_targets(r.on, r.stroke);
-  EXPECT_GT(r.off.f.hausdorff_over_tolerance, 1.1) << r.off.line;
+  EXPECT_LE(r.on.f.hausdorff_over_tolerance, r.off.f.hausdorff_over_tolerance + 0.05)
+      << r.on.line << "\n" << r.off.line;
 }
 
 // A tilted blade's stroke opens from where it starts: the faces that straddle its start are

@@ -80,12 +80,12 @@ TEST(SceneLoader, DefaultsAndScaleBeforeSelectors) {
   EXPECT_EQ(s.solver.backend, Backend::kCpu);
   EXPECT_DOUBLE_EQ(s.material.young_modulus, 3000.0);
   EXPECT_TRUE(s.trajectory.empty());
-  EXPECT_EQ(s.scalpel.shape_guard_deg, 1.0);  // the default (docs/SCENE.md)
+  EXPECT_EQ(s.scalpel.shape_guard_deg, 5.0);  // the default (docs/SCENE.md)
   const std::string guarded = write_file(dir.file("g.yaml"),
                                          "mesh: {file: box.msh}\n"
                                          "fixed: [{nodes: [0]}]\n"
-                                         "scalpel: {shape_guard_deg: 5}\n");
-  EXPECT_DOUBLE_EQ(load_scene(guarded).scalpel.shape_guard_deg, 5.0);
+                                         "scalpel: {shape_guard_deg: 1}\n");
+  EXPECT_DOUBLE_EQ(load_scene(guarded).scalpel.shape_guard_deg, 1.0);
   const std::string unguarded = write_file(dir.file("u.yaml"),
                                            "mesh: {file: box.msh}\n"
                                            "fixed: [{nodes: [0]}]\n"
