@@ -649,8 +649,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
       for (int i = 1; i <= kShiftSteps && !fits; ++i)
         for (const double s : {t - i * options.border_shift / kShiftSteps,
                                t + i * options.border_shift / kShiftSteps})
-          if (!fits && s >= options.snap_tolerance && s <= 1 - options.snap_tolerance &&
-              fits_at(s))
+          if (!fits && s >= options.snap_tolerance && s <= 1 - options.snap_tolerance && fits_at(s))
             t = s, fits = true;
     }
     if (!fits) continue;

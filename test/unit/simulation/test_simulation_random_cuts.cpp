@@ -323,14 +323,14 @@ TEST(SimulationRandomCuts, TetGenLiverInsertionLeavesFewerThinTets) {
 }
 
 // Issue 9 item 4 with the shape guard at its default, 5 deg since stop 51 (scene key
-// scalpel.shape_guard_deg, docs/DESIGN.md section 8 "Shape guard"): after every one of 100 random strokes on the sagging TetGen liver
-// the operation part's smallest dihedral angle stays at least min(5 deg, what it was uncut) -
-// the cutter never makes a tet thinner than 5 deg or than the one it splits - with the cut
-// invariants and every solve converged in at most twice the uncut mesh's CG iterations. The
-// same strokes without it leave 136-152 tets under 5 deg, 0.55-0.68 deg (measured, seeds
-// 20261123, 1, 2; asserted here for seed 1: the guard is what keeps the angle), and at 1 deg
-// (the default until stop 51) the angle stays >= 1 deg. Wedges (test::sharp_wedges: walls
-// meeting under 5 deg, which no repair lifts): none at 1 or 5 deg since flaps are kept joined
+// scalpel.shape_guard_deg, docs/DESIGN.md section 8 "Shape guard"): after every one of 100 random
+// strokes on the sagging TetGen liver the operation part's smallest dihedral angle stays at least
+// min(5 deg, what it was uncut) - the cutter never makes a tet thinner than 5 deg or than the one
+// it splits - with the cut invariants and every solve converged in at most twice the uncut mesh's
+// CG iterations. The same strokes without it leave 136-152 tets under 5 deg, 0.55-0.68 deg
+// (measured, seeds 20261123, 1, 2; asserted here for seed 1: the guard is what keeps the angle),
+// and at 1 deg (the default until stop 51) the angle stays >= 1 deg. Wedges (test::sharp_wedges:
+// walls meeting under 5 deg, which no repair lifts): none at 1 or 5 deg since flaps are kept joined
 // (stop 50, CutOptions::wedge_min_deg), 6 at 1 deg without that (seed 1), 1 with no guard.
 TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
   const Scene scene = fidelity::sagging_liver();
@@ -392,8 +392,8 @@ TEST(SimulationRandomCuts, ShapeGuardKeepsTheOperationPartAboveFiveDegrees) {
                 sim.counts().tets, operation_min_dihedral(sim));
   }
   // Without it, and at 1 deg (the default until stop 51), the same first seed: the thin tets
-  // the 5 deg guard prevents, and the floor 1 deg keeps (the lowest after any stroke: the smoothing and
-  // flips of later strokes may raise the last one). Last, the default guard with nothing to
+  // the 5 deg guard prevents, and the floor 1 deg keeps (the lowest after any stroke: the smoothing
+  // and flips of later strokes may raise the last one). Last, the default guard with nothing to
   // keep flaps joined (CutOptions::wedge_min_deg = 0): the wedges that option prevents.
   struct Case {
     double guard;
