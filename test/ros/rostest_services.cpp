@@ -213,14 +213,14 @@ TEST_F(Fixture, TuningSurvivesReset) {
   double pressure = 0, guard = 0;
   ASSERT_TRUE(ros::param::get("/tissue/cut_pressure", pressure));
   ASSERT_TRUE(ros::param::get("/tissue/shape_guard_deg", guard));
-  EXPECT_EQ(guard, 1.0) << "the scene's default shape guard";
+  EXPECT_EQ(guard, 5.0) << "the scene's default shape guard";
   ASSERT_TRUE(reported("shape guard (deg)", guard)) << "no /diagnostics with the shape guard";
-  ASSERT_TRUE(reconfigure(0.25, 5.0));
-  EXPECT_TRUE(reported("shape guard (deg)", 5.0));
+  ASSERT_TRUE(reconfigure(0.25, 1.0));
+  EXPECT_TRUE(reported("shape guard (deg)", 1.0));
   EXPECT_TRUE(reported("cut pressure (N)", 0.25));
   visualization_msgs::Marker reset_surface;
   ASSERT_TRUE(reset_and_capture(&reset_surface));
-  EXPECT_TRUE(reported("shape guard (deg)", 5.0)) << "the reset dropped the tuned shape guard";
+  EXPECT_TRUE(reported("shape guard (deg)", 1.0)) << "the reset dropped the tuned shape guard";
   EXPECT_TRUE(reported("cut pressure (N)", 0.25)) << "the reset dropped the tuned cut pressure";
   ASSERT_TRUE(reconfigure(pressure, guard));  // as the other tests expect it
   EXPECT_TRUE(reported("shape guard (deg)", guard));
