@@ -169,12 +169,27 @@ struct Shift {
 // border_shift are its range).
 constexpr int kShiftSteps = 10;
 
-// The move of one of `splits`' crossings (those of a tet the guards refuse) along its edge, in
-// steps of split_shift / kShiftSteps up to split_shift, after which every tet on that edge
-// passes the guards with the other crossings as they are: the one that leaves its new node
-// nearest the triangle's plane, if nearer than `limit` (where the end snapped instead lies).
-// An edge already moved (`shifted`) is not moved again, so the rounds of split_along_triangle
-// end.
+// The nearest t' = t -+ k range / kShiftSteps (k = 1, 2, ..., kShiftSteps; t - first) in
+// [snap, 1 - snap] where fits(t'), the search ending at the first k whose offset is not
+// within(offset); NaN if none (docs/DESIGN.md section 8 "Shape guard", eq. (20d)). `offset`
+// gets the k range / kShiftSteps found.
+template <class Within, class Fits>
+double nearest_passing(double t, double range, double snap, Within within, Fits fits,
+                       double& offset) {
+  for (int i = 1; i <= kShiftSteps; ++i) {
+    const double by = i * range / kShiftSteps;
+    if (!within(by)) break;
+    for (const double to : {t - by, t + by})
+      if (to >= snap && to <= 1 - snap && fits(to)) return offset = by, to;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+// The move of one of `splits`' crossings (those of a tet the guards refuse) along its edge
+// (nearest_passing, up to split_shift) after which every tet on that edge passes the guards
+// with its other crossings as they are: the one that leaves its new node nearest the
+// triangle's plane, if nearer than `limit` (where the end snapped instead lies). An edge
+// already moved (`shifted`) is not moved again, so the rounds of split_along_triangle end.
 Shift nearest_shift(const TetMesh& mesh, const CutState& state, const TriangleClassification& tri,
                     const std::vector<Split>& splits,
                     const std::map<std::pair<int, int>, double>& crossing,
@@ -187,21 +202,20 @@ Shift nearest_shift(const TetMesh& mesh, const CutState& state, const TriangleCl
     // How far off the plane the new node moves per unit of t.
     const double rate = std::abs(tri.distance(mesh, sp.a) - tri.distance(mesh, sp.b));
     const std::vector<int> around = tets_with_edge(state, sp.a, sp.b);
-    for (int i = 1; i <= kShiftSteps; ++i) {
-      const double by = i * options.split_shift / kShiftSteps;
-      if (!(by * rate < limit)) break;
-      bool found = false;
-      for (const double to : {sp.t - by, sp.t + by}) {
-        if (found || to < options.snap_tolerance || to > 1 - options.snap_tolerance) continue;
-        std::map<std::pair<int, int>, double> trial = crossing;
-        trial[{sp.a, sp.b}] = to;
-        found = true;
-        for (int k : around)
-          found = found && !too_thin(mesh, state, k, splits_of(mesh.tets[k], trial), options);
-        if (found) limit = by * rate, best = {{sp.a, sp.b}, to};
+    auto fits = [&](double to) {
+      for (int k : around) {
+        std::vector<Split> moved = splits_of(mesh.tets[k], crossing);
+        for (Split& x : moved)
+          if (x.a == sp.a && x.b == sp.b) x.t = to;
+        if (too_thin(mesh, state, k, moved, options)) return false;
       }
-      if (found) break;
-    }
+      return true;
+    };
+    double by = 0;
+    const double to = nearest_passing(
+        sp.t, options.split_shift, options.snap_tolerance,
+        [&](double offset) { return offset * rate < limit; }, fits, by);
+    if (!std::isnan(to)) limit = by * rate, best = {{sp.a, sp.b}, to};
   }
   return best;
 }
@@ -639,18 +653,19 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   for (const auto& entry : crossing) {
     const std::pair<int, int> edge = entry.first;
     double t = entry.second;
+    const std::vector<int> around = tets_with_edge(state, edge.first, edge.second);
     auto fits_at = [&](double s) {
-      for (int k : tets_with_edge(state, edge.first, edge.second))
+      for (int k : around)
         if (too_thin(mesh, state, k, {Split{edge.first, edge.second, s}}, options)) return false;
       return true;
     };
     bool fits = !refused.count(edge) && fits_at(t);
     if (!fits && options.border_shift > 0) {
-      for (int i = 1; i <= kShiftSteps && !fits; ++i)
-        for (const double s : {t - i * options.border_shift / kShiftSteps,
-                               t + i * options.border_shift / kShiftSteps})
-          if (!fits && s >= options.snap_tolerance && s <= 1 - options.snap_tolerance && fits_at(s))
-            t = s, fits = true;
+      double by = 0;
+      const double to = nearest_passing(
+          t, options.border_shift, options.snap_tolerance, [](double) { return true; }, fits_at,
+          by);
+      if (!std::isnan(to)) t = to, fits = true;
     }
     if (!fits) continue;
     const size_t before = result.changed_tets.size();

@@ -70,8 +70,10 @@ struct ScalpelParams {
   // Degrees; 0: off. The cutter's shape guard (CutOptions::split_min_dihedral_deg): no cut
   // makes a tet thinner than this or than the one it splits, at the cost of following the
   // blade less closely (docs/DESIGN.md section 8, "Shape guard"). Extension of this package.
-  // The default, 1 deg, costs no fidelity on the issue 9 stroke matrix; 5 keeps the operation
-  // part above 5 deg at a measured cost (docs/SCENE.md). A Simulation takes this value.
+  // The default, 5 deg (1 before stop 51), keeps every tet a cut makes above 5 deg (or above the
+  // tet it split) at no measured fidelity cost on the issue 9 stroke matrix; a mesh without a
+  // quality bound (TetGen -pQ) is cut with gaps at 5 and wants 1 (docs/SCENE.md). A Simulation
+  // takes this value.
   double shape_guard_deg = 5;
 };
 
