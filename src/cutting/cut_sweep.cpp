@@ -397,8 +397,23 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   std::vector<BladeStop> stops;
   if (limits_ahead(options)) stops.push_back(std::move(stop));
   add_path_limits(state, options, state.stroke_margin, stops);
+  // The faces the front's split makes behind the last band (a slow stroke's band is a step
+  // wide; the front's tets reach farther back) lie along that band's plane, but their centroids
+  // lie outside its triangles, and a curved stroke's earlier bands, at an angle, find them off
+  // their planes: the band reached back a margin along its motion is cut and marked with it
+  // (docs/DESIGN.md section 8, "A stroke's end", eq. (19c)).
+  std::vector<std::array<Vec3, 3>> reached = band;
+  if (options.end_band_reaches_back && !state.last_front.empty() &&
+      band.size() == 2 * (state.last_front.size() - 1)) {
+    for (size_t i = 0; i + 1 < state.last_front.size(); ++i) {
+      const Vec3 back0 = band[2 * i][0] - state.stroke_margin * state.last_front_motion[i],
+                 back1 = band[2 * i][1] - state.stroke_margin * state.last_front_motion[i + 1];
+      reached.push_back({back0, back1, band[2 * i][0]});
+      reached.push_back({band[2 * i][0], back1, band[2 * i][1]});
+    }
+  }
   CutResult result =
-      cut_triangles(mesh, state, band, options, state.last_sweep, front, 1.0, nullptr, stops);
+      cut_triangles(mesh, state, reached, options, state.last_sweep, front, 1.0, nullptr, stops);
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);
