@@ -88,11 +88,17 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
     }
     if (best >= 0) {
       const int m = split_midpoint(mesh, state, k[best], k[(best + 1) % 3], options, result);
-      if (m >= 0) added.push_back(m);
-      continue;
+      if (m >= 0) {
+        added.push_back(m);
+        continue;
+      }
+      if (!options.open_marks_at_centre) continue;
     }
     if (round > 0) continue;
-    // A face alone: its centre, as the midpoint of (the longest edge's midpoint, the far corner).
+    // A face alone, or one whose shared edge the guards keep whole (a corner's face at the
+    // blade's tip, tip_corner.hpp): its centre, as the midpoint of (the longest edge's
+    // midpoint, the far corner).
+    longest = 0;
     for (int e = 0; e < 3; ++e) {
       const double length = (mesh.nodes[k[e]] - mesh.nodes[k[(e + 1) % 3]]).norm();
       if (length > longest) longest = length, best = e;
@@ -132,8 +138,15 @@ int open_closed_marks(TetMesh& mesh, CutState& state, const std::vector<int>& te
   };
   std::vector<int> now = unique(tets);
   int added = open_round(mesh, state, now, options, result, 0, first_new);
-  now.insert(now.end(), result.changed_tets.begin(), result.changed_tets.end());
-  added += open_round(mesh, state, unique(std::move(now)), options, result, 1, first_new);
+  // Then what the opened walls still hold shut, again while that opens more (a face split
+  // at its centre leaves a third of it on the border: the tip's corner, tip_corner.hpp).
+  for (int round = 1, last = added; round <= options.opening_rounds && (round == 1 || last > 0);
+       ++round) {
+    now.insert(now.end(), result.changed_tets.begin(), result.changed_tets.end());
+    now = unique(std::move(now));
+    last = open_round(mesh, state, now, options, result, 1, first_new);
+    added += last;
+  }
   return added;
 }
 

@@ -6,9 +6,11 @@
 // usually complete the fans around it. When the stroke ends nothing comes later: such a mark
 // would stay a hole in the opened surface at the tip's path or the front. So it gets a corner
 // that is not on the border: a node at the midpoint of its edge that another mark shares (the
-// node's fan is then those marks' halves), or, for a face alone, at its centre (two midpoint
-// splits), and the marks are separated again. Only marks along the blade's own sweep
-// (CutState::blade_sweep), with a shape guard of at least 5 deg on these splits.
+// node's fan is then those marks' halves), or, for a face alone or one whose shared edge the
+// guards keep whole, at its centre (two midpoint splits), and the marks are separated again;
+// then what opened walls still hold shut, up to CutOptions::opening_rounds times. Only marks along
+// the blade's own sweep (CutState::blade_sweep), with a shape guard of at least 5 deg on these
+// splits.
 #pragma once
 
 #include "cutting/cut_state.hpp"

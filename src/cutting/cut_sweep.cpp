@@ -4,6 +4,7 @@
 #include "cutting/cut_smoothing.hpp"
 #include "cutting/earlier_triangles.hpp"
 #include "cutting/separation.hpp"
+#include "cutting/tip_corner.hpp"
 #include "cutting/triangle_cut.hpp"
 
 #include <algorithm>
@@ -414,6 +415,14 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   }
   CutResult result =
       cut_triangles(mesh, state, reached, options, state.last_sweep, front, 1.0, nullptr, stops);
+  // Where the tip's path meets the front the opened surface may stop an element short of the
+  // tip (tip_corner.hpp).
+  if (options.fill_tip_corner) {
+    const long marked_before = count_marked_face_sides(mesh);
+    const size_t changed_before = result.changed_tets.size();
+    if (fill_tip_corner(mesh, state, state.last_sweep_end[0], band, options, result) >= 0)
+      settle(mesh, state, result, changed_before, marked_before);
+  }
   if (!options.open_closed_marks) return result;
   // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
   const long marked_before = count_marked_face_sides(mesh);

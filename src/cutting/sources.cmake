@@ -14,6 +14,7 @@ list(APPEND TISSUE_CORE_SOURCES
   src/cutting/separation.cpp
   src/cutting/tet_flips.cpp
   src/cutting/tet_grid.cpp
+  src/cutting/tip_corner.cpp
   src/cutting/triangle_cut.cpp
   src/cutting/vertex_insertion.cpp
 )

@@ -391,6 +391,15 @@ bool best_flip(const TetMesh& mesh, const CutState& state, int t, const CutOptio
 
 }  // namespace
 
+int apply_insertion(TetMesh& mesh, CutState& state, const VertexInsertion& insertion,
+                    CutResult& result, bool shape) {
+  const int node = mesh.num_nodes();
+  const std::vector<int> changed = apply(mesh, state, as_flip(insertion), result);
+  if (!shape) --result.nodes_inserted;
+  result.changed_tets.insert(result.changed_tets.end(), changed.begin(), changed.end());
+  return node;
+}
+
 FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
                           const std::vector<int>& tets, CutResult& result) {
   FlipCounts flips;

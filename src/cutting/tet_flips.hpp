@@ -14,6 +14,7 @@
 #pragma once
 
 #include "cutting/cut_state.hpp"
+#include "cutting/vertex_insertion.hpp"
 #include "soft_tissue_cutting/cutting/cut_result.hpp"
 
 #include <vector>
@@ -26,6 +27,14 @@ struct FlipCounts {
   int insertions = 0;  // vertex insertions (vertex_insertion.hpp)
   int total() const { return faces + edges + insertions; }
 };
+
+// Replaces an insertion's cavity by its tets, the new node appended (its displacement
+// interpolated in the host tet, docs/DESIGN.md eq. (21a)) and reported in result.new_nodes; the
+// cavity's boundary faces keep their cut marks. Returns the new node; the changed and appended
+// tets go to result.changed_tets. Counted in result.nodes_inserted only if `shape` (a node
+// for the mesh's shape, not the cut's).
+int apply_insertion(TetMesh& mesh, CutState& state, const VertexInsertion& insertion,
+                    CutResult& result, bool shape);
 
 // Flips that raise the smallest dihedral angle of `tets` below CutOptions::smooth_below_deg
 // (and of the tets the flips make), each by more than 0.05 deg over the tets it replaces and

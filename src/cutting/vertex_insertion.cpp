@@ -92,17 +92,18 @@ Vec3 ascend(Vec3 x, double scale, const Measure& measure) {
   return x;
 }
 
-}  // namespace
-
-bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
-                      double guard, VertexInsertion& insertion) {
+// The cavity's description and its new tets (one per boundary face, with kInsertedNode): false
+// if a tet of it is not cuttable, a face inside it is on a cut or a corner lies inside it.
+bool describe_cavity(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                     VertexInsertion& insertion, double& volume, double& flattest,
+                     double& shortest) {
   std::sort(cavity.begin(), cavity.end());
   cavity.erase(std::unique(cavity.begin(), cavity.end()), cavity.end());
   insertion = VertexInsertion{};
   insertion.cavity = cavity;
   insertion.before = 180;
   insertion.size_class = 1e300;
-  double volume = 0, flattest = 1e300, shortest = 1e300;
+  volume = 0, flattest = 1e300, shortest = 1e300;
   std::set<int> corners, on_boundary;
   for (int c : cavity) {
     if (!state.cuttable[static_cast<size_t>(c)]) return false;
@@ -130,12 +131,45 @@ bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<in
       for (int i : kTetFaces[static_cast<size_t>(f)]) on_boundary.insert(k[static_cast<size_t>(i)]);
     }
   }
-  if (on_boundary.size() != corners.size()) return false;  // a corner inside would be lost
+  return on_boundary.size() == corners.size();  // a corner inside would be lost
+}
+
+// The new tets' total volume equals the cavity's (to 1e-12: they tile it) and the cavity tet
+// that holds `x` (the most inside one: round-off on a shared face) with x's weights in it.
+bool tiles_and_locate(const TetMesh& mesh, const Vec3& x, double volume,
+                      VertexInsertion& insertion) {
+  double tiled = 0;
+  for (const Tet& k : insertion.tets) tiled += volume_with(mesh, k, x);
+  if (std::abs(tiled - volume) > 1e-12 * volume) return false;
+  double inside = -1e300;
+  for (int c : insertion.cavity) {
+    const Tet& k = mesh.tets[static_cast<size_t>(c)];
+    const double v = tet_volume(mesh, c);
+    std::array<double, 4> w{};
+    for (int i = 0; i < 4; ++i) {
+      Tet sub = k;
+      sub[static_cast<size_t>(i)] = kInsertedNode;
+      w[static_cast<size_t>(i)] = volume_with(mesh, sub, x) / v;
+    }
+    if (const double least = *std::min_element(w.begin(), w.end()); least > inside)
+      inside = least, insertion.host = k, insertion.weights = w;
+  }
+  insertion.point = x;
+  return inside > -1e-9;
+}
+
+}  // namespace
+
+bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                      double guard, VertexInsertion& insertion) {
+  double volume = 0, flattest = 0, shortest = 0;
+  if (!describe_cavity(mesh, state, std::move(cavity), insertion, volume, flattest, shortest))
+    return false;
   // Where every new tet is positive, if anywhere: the point deepest inside every boundary
   // face, found from the best cavity tet's centroid.
   Vec3 x = Vec3::Zero();
   double deepest = -1e300;
-  for (int c : cavity) {
+  for (int c : insertion.cavity) {
     Vec3 centroid = Vec3::Zero();
     for (int v : mesh.tets[static_cast<size_t>(c)])
       centroid += mesh.nodes[static_cast<size_t>(v)] / 4;
@@ -168,30 +202,39 @@ bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<in
   });
   insertion.after = quality_at(mesh, insertion.tets, x, min_volume);
   if (!(insertion.after > 0)) return false;
-  double tiled = 0, flattest_new = 1e300;
-  for (const Tet& k : insertion.tets) {
-    tiled += volume_with(mesh, k, x);
+  double flattest_new = 1e300;
+  for (const Tet& k : insertion.tets)
     flattest_new =
         std::min(flattest_new, volume_ratio(corner(mesh, k[0], x), corner(mesh, k[1], x),
                                             corner(mesh, k[2], x), corner(mesh, k[3], x)));
+  if (flattest_new < flattest) return false;
+  return tiles_and_locate(mesh, x, volume, insertion);
+}
+
+bool vertex_insertion_at(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                         const std::vector<Vec3>& points, double guard, double min_angle_deg,
+                         VertexInsertion& insertion) {
+  double volume = 0, flattest = 0, shortest = 0;
+  if (!describe_cavity(mesh, state, std::move(cavity), insertion, volume, flattest, shortest))
+    return false;
+  const double min_volume = guard * insertion.size_class;
+  const Vec3* best = nullptr;
+  insertion.after = -1;
+  for (const Vec3& p : points)
+    if (const double q = quality_at(mesh, insertion.tets, p, min_volume); q > insertion.after)
+      insertion.after = q, best = &p;
+  // The new tet that is worst there (the first not above the size guard, else the flattest):
+  // a larger cavity may replace its face.
+  const Vec3& at = best ? *best : points.front();
+  double worst = 1e300;
+  for (size_t i = 0; i < insertion.tets.size(); ++i) {
+    const Tet& k = insertion.tets[i];
+    const double angle = volume_with(mesh, k, at) > min_volume ? angle_with(mesh, k, at) : -1.0;
+    if (angle < worst) worst = angle, insertion.worst = static_cast<int>(i);
+    if (angle < 0) break;
   }
-  if (std::abs(tiled - volume) > 1e-12 * volume || flattest_new < flattest) return false;
-  // The cavity tet that holds the point (the most inside one: round-off on a shared face).
-  double inside = -1e300;
-  for (int c : cavity) {
-    const Tet& k = mesh.tets[static_cast<size_t>(c)];
-    const double v = tet_volume(mesh, c);
-    std::array<double, 4> w{};
-    for (int i = 0; i < 4; ++i) {
-      Tet sub = k;
-      sub[static_cast<size_t>(i)] = kInsertedNode;
-      w[static_cast<size_t>(i)] = volume_with(mesh, sub, x) / v;
-    }
-    if (const double least = *std::min_element(w.begin(), w.end()); least > inside)
-      inside = least, insertion.host = k, insertion.weights = w;
-  }
-  insertion.point = x;
-  return inside > -1e-9;
+  if (!best || !(insertion.after >= min_angle_deg) || !(insertion.after > 0)) return false;
+  return tiles_and_locate(mesh, *best, volume, insertion);
 }
 
 std::vector<std::vector<int>> insertion_cavities(const TetMesh& mesh, const CutState& state,

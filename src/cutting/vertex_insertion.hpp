@@ -28,6 +28,7 @@ struct VertexInsertion {
   double size_class = 0;            // the smallest of the cavity's: the new tets'
   double before = 0;                // smallest dihedral angle of the cavity's tets
   double after = 0;                 // of the new ones
+  int worst = -1;  // vertex_insertion_at: the new tet worst at the best place (a refusal's why)
 };
 
 // The insertion into `cavity` (tet indices) at the position that maximises the new tets'
@@ -37,6 +38,13 @@ struct VertexInsertion {
 // than the cavity's flattest tet.
 bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
                       double guard, VertexInsertion& insertion);
+
+// The insertion into `cavity` at the best of given points (a cut's node near where the blade's
+// tip stopped, tip_corner.hpp): the same rules on the cavity, every new tet above `guard` of the
+// size class and its smallest dihedral angle at least min_angle_deg, tiling the cavity.
+bool vertex_insertion_at(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                         const std::vector<Vec3>& points, double guard, double min_angle_deg,
+                         VertexInsertion& insertion);
 
 // The cavities tried for tet t: t with its neighbours across its faces on no cut, and the ring
 // of each of its edges (3 to 10 tets).

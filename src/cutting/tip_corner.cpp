@@ -1,0 +1,233 @@
+#include "cutting/tip_corner.hpp"
+
+#include "cutting/tet_flips.hpp"
+#include "cutting/triangle_cut.hpp"
+#include "cutting/vertex_insertion.hpp"
+#include "soft_tissue_cutting/collision/blade.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace stc {
+namespace {
+
+// Samples per triangle side when looking for the tets a corner's triangle passes through:
+// centroids of an n x n subdivision, strictly inside it (its edge on the border is not crossed).
+constexpr int kSamplesPerSide = 24;
+// The node's places tried: rings about the tip (a quarter disc, kPlaceAngles steps of angle).
+constexpr int kPlaceRings = 4;
+constexpr int kPlaceAngles = 8;
+// How many tets the cavity may grow by when a new tet is too thin.
+constexpr int kMaxGrowth = 4;
+
+bool holds_point(const TetMesh& mesh, int t, const Vec3& p) {
+  const Tet& k = mesh.tets[static_cast<size_t>(t)];
+  const Vec3* x[4] = {&mesh.nodes[k[0]], &mesh.nodes[k[1]], &mesh.nodes[k[2]], &mesh.nodes[k[3]]};
+  const double v = signed_volume(*x[0], *x[1], *x[2], *x[3]);
+  for (int i = 0; i < 4; ++i) {
+    const Vec3* y[4] = {x[0], x[1], x[2], x[3]};
+    y[i] = &p;
+    if (signed_volume(*y[0], *y[1], *y[2], *y[3]) < -1e-9 * v) return false;
+  }
+  return true;
+}
+
+// A border edge (a, b) of the cut facing the tip, the triangle (tip, a, b) filling the corner
+// between them, and its angles about the tip in the blade's plane.
+struct CornerTriangle {
+  int a = -1, b = -1;
+  double distance = 0;  // tip to the segment
+  double from = 0, to = 0;
+};
+
+double angle_in_plane(const Vec3& d, const Vec3& u, const Vec3& v) {
+  return std::atan2(d.dot(v), d.dot(u));
+}
+
+bool arcs_overlap(const CornerTriangle& p, const CornerTriangle& q) {
+  // Each arc is shorter than pi (a triangle's angle): overlap iff a midpoint lies within the
+  // other's half-width (angles wrapped).
+  const auto wrap = [](double x) { return std::remainder(x, 2 * M_PI); };
+  const double mp = p.from + 0.5 * wrap(p.to - p.from), mq = q.from + 0.5 * wrap(q.to - q.from);
+  const double hp = 0.5 * std::abs(wrap(p.to - p.from)), hq = 0.5 * std::abs(wrap(q.to - q.from));
+  return std::abs(wrap(mp - mq)) < hp + hq - 1e-9;
+}
+
+}  // namespace
+
+int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
+                    const std::vector<std::array<Vec3, 3>>& band, const CutOptions& options,
+                    CutResult& result) {
+  const double margin = state.stroke_margin;
+  if (!(margin > 0) || !tip.allFinite()) return -1;
+  // The blade's plane where it stopped: the band's tip-side triangle that holds the blade's
+  // last edge (cut_band's (A0, B1, B0); a curved stroke's band is twisted).
+  if (band.size() < 2) return -1;
+  const auto& last = band[1];
+  Vec3 normal = (last[1] - last[0]).cross(last[2] - last[0]);
+  if (!(normal.norm() > 0)) return -1;  // a plunge sweeps nothing
+  normal.normalize();
+  const Vec3 u = (last[1] - last[2]).normalized(), v = normal.cross(u);
+  bool in_tissue = false;
+  for (int t : state.grid.query(mesh, tip, tip)) in_tissue = in_tissue || holds_point(mesh, t, tip);
+  if (!in_tissue) return -1;
+  // The margin is a quarter of the band's mean edge (CutOptions::front_margin_fraction): an
+  // element's reach is four of them.
+  const double reach = 4 * margin, snap = options.snap_tolerance * reach;
+  const std::vector<int> near =
+      state.grid.query(mesh, tip - Vec3::Constant(reach), tip + Vec3::Constant(reach));
+  // The marked faces near the tip: covered already (within a margin), or their edges facing it
+  // - of opened walls only: a closed mark may still open at the stroke's end (closed_marks.hpp),
+  // and a triangle hung on it would be one more whose corners all lie on the border (on the
+  // fine liver2's tilted straight 3 mm stroke the marks at the tip then all stayed shut).
+  // edge -> every mark on it is opened and lies away from the tip
+  std::map<std::pair<int, int>, bool> facing;
+  for (int t : near)
+    for (int f = 0; f < 4; ++f) {
+      if (!mesh.is_cut_face(t, f)) continue;
+      const FaceKey key = face_key(mesh.tets[static_cast<size_t>(t)], f);
+      Vec3 w;
+      const Vec3 closest = closest_point_on_triangle(tip, mesh.nodes[key[0]], mesh.nodes[key[1]],
+                                                     mesh.nodes[key[2]], w);
+      if ((closest - tip).norm() <= margin) return -1;
+      for (int e = 0; e < 3; ++e) {
+        const int a = std::min(key[e], key[(e + 1) % 3]), b = std::max(key[e], key[(e + 1) % 3]);
+        const Vec3 &xa = mesh.nodes[a], &xb = mesh.nodes[b], &xc = mesh.nodes[key[(e + 2) % 3]];
+        const double tip_side = normal.dot((xb - xa).cross(tip - xa)),
+                     mark_side = normal.dot((xb - xa).cross(xc - xa));
+        const bool opened = neighbour_across(mesh, state, t, f).first < 0;
+        auto it = facing.emplace(std::make_pair(a, b), true).first;
+        it->second = it->second && opened && tip_side * mark_side < 0;
+      }
+    }
+  // The corner's triangles: each border edge facing the tip, on the plane (within the snap
+  // distance), an element at most away, more than a margin from it; nearest first, as a fan
+  // whose triangles do not overlap.
+  std::vector<CornerTriangle> candidates;
+  for (const auto& [edge, away] : facing) {
+    if (!away) continue;
+    const Vec3 &xa = mesh.nodes[edge.first], &xb = mesh.nodes[edge.second];
+    if ((xa - tip).norm() > reach || (xb - tip).norm() > reach) continue;
+    if (std::abs(normal.dot(xa - tip)) > snap || std::abs(normal.dot(xb - tip)) > snap) continue;
+    CornerTriangle c;
+    c.a = edge.first, c.b = edge.second;
+    c.distance = (closest_point_on_segment(xa, xb, tip) - tip).norm();
+    if (!(c.distance > margin)) continue;
+    c.from = angle_in_plane(xa - tip, u, v), c.to = angle_in_plane(xb - tip, u, v);
+    candidates.push_back(c);
+  }
+  std::sort(
+      candidates.begin(), candidates.end(),
+      [](const CornerTriangle& p, const CornerTriangle& q) { return p.distance < q.distance; });
+  std::vector<CornerTriangle> fan;
+  for (const CornerTriangle& c : candidates)
+    if (std::none_of(fan.begin(), fan.end(),
+                     [&](const CornerTriangle& f) { return arcs_overlap(c, f); }))
+      fan.push_back(c);
+  if (fan.empty()) return -1;
+  // Where the node may go: on the blade's plane, within a margin of the tip, behind its front
+  // and above its path (inside the sweep), the place that makes the best tets.
+  Vec3 ahead = v;
+  if (ahead.dot(last[2] - last[0]) < 0) ahead = -ahead;
+  std::vector<Vec3> places = {tip};
+  for (int r = 1; r <= kPlaceRings; ++r)
+    for (int k = 0; k <= kPlaceAngles; ++k) {
+      const double angle = 0.5 * M_PI * k / kPlaceAngles, radius = margin * r / kPlaceRings;
+      places.push_back(tip + radius * (std::cos(angle) * u - std::sin(angle) * ahead));
+    }
+  // An insertion at the best of `at` into `cavity`, grown across the face of the worst new tet
+  // (a thin tet between the node and a face of the cavity nearly through it) while refused.
+  // Tets on an edge in `keep` are not added (the edge must stay on the boundary: the faces
+  // from the node to it are the marks).
+  const auto insert_growing = [&](std::vector<int> cavity, const std::vector<Vec3>& at,
+                                  const std::vector<std::pair<int, int>>& keep,
+                                  VertexInsertion& insertion) {
+    for (int grow = 0; grow <= kMaxGrowth; ++grow) {
+      if (vertex_insertion_at(mesh, state, cavity, at, 2 * options.min_volume_fraction,
+                              options.split_min_dihedral_deg, insertion))
+        return true;
+      if (insertion.worst < 0) return false;
+      FaceKey face{};
+      int n = 0;
+      for (int w : insertion.tets[static_cast<size_t>(insertion.worst)])
+        if (w != kInsertedNode && n < 3) face[static_cast<size_t>(n++)] = w;
+      std::sort(face.begin(), face.end());
+      int across = -1;
+      for (int c : insertion.cavity)
+        for (int f = 0; f < 4 && across < 0; ++f)
+          if (face_key(mesh.tets[static_cast<size_t>(c)], f) == face && !mesh.is_cut_face(c, f))
+            across = neighbour_across(mesh, state, c, f).first;
+      if (across < 0) return false;
+      const Tet& k = mesh.tets[static_cast<size_t>(across)];
+      for (const auto& e : keep)
+        if (std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
+          return false;
+      cavity = insertion.cavity;
+      cavity.push_back(across);
+    }
+    return false;
+  };
+  // Do the new tets have faces (node, a, b) for each edge (a, b)?
+  const auto has_faces = [](const VertexInsertion& insertion,
+                            const std::vector<std::pair<int, int>>& edges) {
+    return std::all_of(edges.begin(), edges.end(), [&](const std::pair<int, int>& e) {
+      for (const Tet& k : insertion.tets)
+        if (std::count(k.begin(), k.end(), kInsertedNode) &&
+            std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
+          return true;
+      return false;
+    });
+  };
+  // The cavity: the tets the fan's triangles pass through. The whole fan, else its triangles
+  // one by one, nearest first (a boundary face of the cavity may lie on the plane, the node
+  // flat against it).
+  const auto insert_for = [&](const std::vector<CornerTriangle>& triangles,
+                              VertexInsertion& insertion) {
+    std::vector<int> cavity;
+    for (const CornerTriangle& c : triangles) {
+      const Vec3 &xa = mesh.nodes[c.a], &xb = mesh.nodes[c.b];
+      for (int i = 0; i < kSamplesPerSide; ++i)
+        for (int j = 0; i + j < kSamplesPerSide; ++j)
+          for (double shift : {1.0 / 3, 2.0 / 3}) {
+            if (shift > 0.5 && i + j + 1 >= kSamplesPerSide) continue;
+            const Vec3 p =
+                tip + ((i + shift) * (xa - tip) + (j + shift) * (xb - tip)) / kSamplesPerSide;
+            for (int t : state.grid.query(mesh, p, p))
+              if (holds_point(mesh, t, p)) cavity.push_back(t);
+          }
+    }
+    std::vector<std::pair<int, int>> edges;
+    for (const CornerTriangle& c : triangles) edges.emplace_back(c.a, c.b);
+    if (!insert_growing(cavity, places, edges, insertion)) return false;
+    // Every triangle is a face of the new tets (its border edge on the cavity's boundary):
+    // else the node would not fill the corner.
+    return has_faces(insertion, edges);
+  };
+  std::vector<std::vector<CornerTriangle>> tries = {fan};
+  if (fan.size() > 1)
+    for (const CornerTriangle& c : fan) tries.push_back({c});
+  VertexInsertion insertion;
+  auto chosen = std::find_if(tries.begin(), tries.end(), [&](const auto& triangles) {
+    return insert_for(triangles, insertion);
+  });
+  if (chosen == tries.end()) return -1;
+  fan = *chosen;
+  const int node = apply_insertion(mesh, state, insertion, result, false);
+  set_on_stroke(state, node);
+  // Its corners all lie on the cut's border, so each triangle marked stays closed until the
+  // stroke's end gives it a corner inside the cut (closed_marks.hpp). (A node inside the
+  // triangle at once, its two tets split at a point of it, would open it here: on the thigh's
+  // curved 45-degree stroke the best such split left a 2.9 deg tet, under the guard.)
+  for (int t : state.node_tets[static_cast<size_t>(node)])
+    for (int f = 0; f < 4; ++f) {
+      const FaceKey key = face_key(mesh.tets[static_cast<size_t>(t)], f);
+      for (const CornerTriangle& c : fan)
+        if (std::count(key.begin(), key.end(), node) && std::count(key.begin(), key.end(), c.a) &&
+            std::count(key.begin(), key.end(), c.b))
+          mesh.cut_faces[static_cast<size_t>(t)] |= static_cast<std::uint8_t>(1u << f);
+    }
+  return node;
+}
+
+}  // namespace stc
