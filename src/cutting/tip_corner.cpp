@@ -136,49 +136,6 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
       const double angle = 0.5 * M_PI * k / kPlaceAngles, radius = margin * r / kPlaceRings;
       places.push_back(tip + radius * (std::cos(angle) * u - std::sin(angle) * ahead));
     }
-  // An insertion at the best of `at` into `cavity`, grown across the face of the worst new tet
-  // (a thin tet between the node and a face of the cavity nearly through it) while refused.
-  // Tets on an edge in `keep` are not added (the edge must stay on the boundary: the faces
-  // from the node to it are the marks).
-  const auto insert_growing = [&](std::vector<int> cavity, const std::vector<Vec3>& at,
-                                  const std::vector<std::pair<int, int>>& keep,
-                                  VertexInsertion& insertion) {
-    for (int grow = 0; grow <= kMaxGrowth; ++grow) {
-      if (vertex_insertion_at(mesh, state, cavity, at, 2 * options.min_volume_fraction,
-                              options.split_min_dihedral_deg, insertion))
-        return true;
-      if (insertion.worst < 0) return false;
-      FaceKey face{};
-      int n = 0;
-      for (int w : insertion.tets[static_cast<size_t>(insertion.worst)])
-        if (w != kInsertedNode && n < 3) face[static_cast<size_t>(n++)] = w;
-      std::sort(face.begin(), face.end());
-      int across = -1;
-      for (int c : insertion.cavity)
-        for (int f = 0; f < 4 && across < 0; ++f)
-          if (face_key(mesh.tets[static_cast<size_t>(c)], f) == face && !mesh.is_cut_face(c, f))
-            across = neighbour_across(mesh, state, c, f).first;
-      if (across < 0) return false;
-      const Tet& k = mesh.tets[static_cast<size_t>(across)];
-      for (const auto& e : keep)
-        if (std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
-          return false;
-      cavity = insertion.cavity;
-      cavity.push_back(across);
-    }
-    return false;
-  };
-  // Do the new tets have faces (node, a, b) for each edge (a, b)?
-  const auto has_faces = [](const VertexInsertion& insertion,
-                            const std::vector<std::pair<int, int>>& edges) {
-    return std::all_of(edges.begin(), edges.end(), [&](const std::pair<int, int>& e) {
-      for (const Tet& k : insertion.tets)
-        if (std::count(k.begin(), k.end(), kInsertedNode) &&
-            std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
-          return true;
-      return false;
-    });
-  };
   // The cavity: the tets the fan's triangles pass through. The whole fan, else its triangles
   // one by one, nearest first (a boundary face of the cavity may lie on the plane, the node
   // flat against it).
@@ -199,10 +156,11 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
     }
     std::vector<std::pair<int, int>> edges;
     for (const CornerTriangle& c : triangles) edges.emplace_back(c.a, c.b);
-    if (!insert_growing(cavity, places, edges, insertion)) return false;
-    // Every triangle is a face of the new tets (its border edge on the cavity's boundary):
-    // else the node would not fill the corner.
-    return has_faces(insertion, edges);
+    // Every triangle must be a face of the new tets (its border edge on the cavity's
+    // boundary): else the node would not fill the corner.
+    return vertex_insertion_growing(mesh, state, cavity, places, 2 * options.min_volume_fraction,
+                                    options.split_min_dihedral_deg, edges, kMaxGrowth, insertion) &&
+           joins_edges(insertion, edges);
   };
   std::vector<std::vector<CornerTriangle>> tries = {fan};
   if (fan.size() > 1)

@@ -237,6 +237,45 @@ bool vertex_insertion_at(const TetMesh& mesh, const CutState& state, std::vector
   return tiles_and_locate(mesh, *best, volume, insertion);
 }
 
+bool vertex_insertion_growing(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                              const std::vector<Vec3>& points, double guard, double min_angle_deg,
+                              const std::vector<std::pair<int, int>>& keep, int max_growth,
+                              VertexInsertion& insertion) {
+  for (int grow = 0; grow <= max_growth; ++grow) {
+    if (vertex_insertion_at(mesh, state, cavity, points, guard, min_angle_deg, insertion))
+      return true;
+    if (grow == max_growth || insertion.worst < 0) return false;
+    FaceKey face{};
+    int n = 0;
+    for (int w : insertion.tets[static_cast<size_t>(insertion.worst)])
+      if (w != kInsertedNode && n < 3) face[static_cast<size_t>(n++)] = w;
+    std::sort(face.begin(), face.end());
+    int across = -1;
+    for (int c : insertion.cavity)
+      for (int f = 0; f < 4 && across < 0; ++f)
+        if (face_key(mesh.tets[static_cast<size_t>(c)], f) == face && !mesh.is_cut_face(c, f))
+          across = neighbour_across(mesh, state, c, f).first;
+    if (across < 0) return false;
+    const Tet& k = mesh.tets[static_cast<size_t>(across)];
+    for (const auto& e : keep)
+      if (std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
+        return false;
+    cavity = insertion.cavity;
+    cavity.push_back(across);
+  }
+  return false;
+}
+
+bool joins_edges(const VertexInsertion& insertion, const std::vector<std::pair<int, int>>& edges) {
+  return std::all_of(edges.begin(), edges.end(), [&](const std::pair<int, int>& e) {
+    for (const Tet& k : insertion.tets)
+      if (std::count(k.begin(), k.end(), kInsertedNode) &&
+          std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
+        return true;
+    return false;
+  });
+}
+
 std::vector<std::vector<int>> insertion_cavities(const TetMesh& mesh, const CutState& state,
                                                  int t) {
   std::vector<std::vector<int>> cavities;

@@ -11,6 +11,7 @@
 #include "cutting/cut_state.hpp"
 
 #include <array>
+#include <utility>
 #include <vector>
 
 namespace stc {
@@ -45,6 +46,19 @@ bool vertex_insertion(const TetMesh& mesh, const CutState& state, std::vector<in
 bool vertex_insertion_at(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
                          const std::vector<Vec3>& points, double guard, double min_angle_deg,
                          VertexInsertion& insertion);
+
+// vertex_insertion_at into `cavity`, grown while refused across the boundary face of the worst
+// new tet (a thin tet between the node and a face of the cavity nearly through it) by the tet
+// beyond it - at most max_growth tets, none across a cut face and none on an edge of `keep`
+// (edges that must stay on the cavity's boundary, the faces from the node to them wanted: a tet
+// beyond may hold a face along them on the same plane, as a neighbouring mark's).
+bool vertex_insertion_growing(const TetMesh& mesh, const CutState& state, std::vector<int> cavity,
+                              const std::vector<Vec3>& points, double guard, double min_angle_deg,
+                              const std::vector<std::pair<int, int>>& keep, int max_growth,
+                              VertexInsertion& insertion);
+
+// Does the insertion make a face (new node, a, b) for every edge (a, b)?
+bool joins_edges(const VertexInsertion& insertion, const std::vector<std::pair<int, int>>& edges);
 
 // The cavities tried for tet t: t with its neighbours across its faces on no cut, and the ring
 // of each of its edges (3 to 10 tets).
