@@ -5,6 +5,7 @@
 #include "cutting/triangle_cut.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -18,6 +19,8 @@ namespace {
 // 1 deg, 691 with 5 deg, 665 with 10 deg; the 40 strokes of the fidelity matrix' summed excess
 // over the Hausdorff tolerance 6.29, 5.16, 5.38, 5.75.
 constexpr double kOpeningGuardDeg = 5.0;
+// Where along an edge an opening split is tried, in order.
+constexpr double kOpeningSplits[] = {0.5, 0.4, 0.6, 0.3, 0.7, 0.2, 0.8};
 
 // Bisects edge (a, b) at its midpoint if it still exists and every tet on it is cuttable and
 // passes the guards (kOpeningGuardDeg); returns the new node or -1.
@@ -29,16 +32,23 @@ int split_midpoint(TetMesh& mesh, CutState& state, int a, int b, const CutOption
   CutOptions guarded = options;
   guarded.split_min_dihedral_deg = std::max(options.split_min_dihedral_deg, kOpeningGuardDeg);
   for (int t : ring)
-    if (!state.cuttable[static_cast<size_t>(t)] ||
-        split_too_thin(mesh, state, t, a, b, 0.5, guarded))
-      return -1;
-  const size_t before = result.changed_tets.size();
-  const int m = bisect_edge(mesh, state, a, b, 0.5, result.changed_tets);
-  result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
-  set_on_stroke(state, m);
-  set_opened_at_end(state, m);
-  result.new_nodes.push_back(NewNode::on_edge(m, a, b, 0.5));
-  return m;
+    if (!state.cuttable[static_cast<size_t>(t)]) return -1;
+  // The midpoint, else the nearest place to it along the edge the guards allow (the node's fan
+  // is the marks' two parts wherever it lies on the edge).
+  for (double at : kOpeningSplits) {
+    if (!options.opening_split_shift && at != 0.5) break;
+    if (std::any_of(ring.begin(), ring.end(),
+                    [&](int t) { return split_too_thin(mesh, state, t, a, b, at, guarded); }))
+      continue;
+    const size_t before = result.changed_tets.size();
+    const int m = bisect_edge(mesh, state, a, b, at, result.changed_tets);
+    result.tets_split += static_cast<int>(result.changed_tets.size() - before) / 2;
+    set_on_stroke(state, m);
+    set_opened_at_end(state, m);
+    result.new_nodes.push_back(NewNode::on_edge(m, a, b, at));
+    return m;
+  }
+  return -1;
 }
 
 // One round: round 0 splits an edge that another mark shares, round 1 (what round 0's marks
@@ -47,6 +57,7 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
                const CutOptions& options, CutResult& result, int round, int first_new) {
   // The marked faces around the stroke, closed ones apart, and how many marks use each edge.
   std::set<FaceKey> closed, marked, opened;
+  std::map<FaceKey, double> size_class;  // the origin volume of a tet on the face
   for (int t : tets) {
     if (t < 0 || t >= mesh.num_tets() || !state.cuttable[static_cast<size_t>(t)]) continue;
     for (int f = 0; f < 4; ++f) {
@@ -54,6 +65,7 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
       const FaceKey key = face_key(mesh.tets[static_cast<size_t>(t)], f);
       marked.insert(key);
       (neighbour_across(mesh, state, t, f).first >= 0 ? closed : opened).insert(key);
+      size_class[key] = state.origin_volume[static_cast<size_t>(t)];
     }
   }
   if (closed.empty()) return 0;
@@ -66,16 +78,21 @@ int open_round(TetMesh& mesh, CutState& state, const std::vector<int>& tets,
   const StrokeSurface surface(state.blade_sweep);
   for (const FaceKey& k : closed) {
     // Only a face along the stroke's surface (its corners within kOnCutSlack of its longest
-    // edge, no skin slack): a mark left closed may reach farther, and opened it would be a
-    // wall off the blade's path.
+    // edge - or of the edge of the input tet it was split from, CutOptions::
+    // open_marks_at_input_scale - no skin slack): a mark left closed may reach farther, and
+    // opened it would be a wall off the blade's path.
     double face_longest = 0;
     for (int e = 0; e < 3; ++e)
       face_longest = std::max(face_longest, (mesh.nodes[k[e]] - mesh.nodes[k[(e + 1) % 3]]).norm());
     bool along = true;
     for (int v : k)  // made at an earlier stroke's end (this one's second round may use its own)
       along = along && !(v < first_new && was_opened_at_end(state, v));
+    // The input tet's edge: a regular tet's of its volume (the size class).
+    const double original_edge = std::cbrt(6 * std::sqrt(2.0) * size_class[k]);
+    const double scale =
+        options.open_marks_at_input_scale ? std::max(face_longest, original_edge) : face_longest;
     for (int e = 0; e < 3 && along; ++e)
-      along = surface.near(mesh.nodes[k[e]], kOnCutSlack * face_longest);
+      along = surface.near(mesh.nodes[k[e]], kOnCutSlack * scale);
     if (!along) continue;
     // The face's longest edge another mark shares.
     int best = -1;

@@ -167,6 +167,16 @@ struct CutOptions {
   // A closed mark at a stroke's end whose edge shared with another mark the guards keep whole is
   // split at its centre instead (cutting/closed_marks.hpp).
   bool open_marks_at_centre = true;
+  // A closed mark counts as lying along the blade's sweep with its corners within the slack of
+  // the larger of its longest edge and the edge of the input tet it was split from (the scale
+  // of issue 9's Hausdorff tolerance): a mark split small near the tip's path was judged by its
+  // own size and left shut (closed_marks.hpp; docs/DESIGN.md section 8, "Closed marks"; stop 53).
+  bool open_marks_at_input_scale = true;
+  // Where the guards refuse an opening split at an edge's midpoint, the nearest place along
+  // the edge they allow (0.4-0.6, 0.3-0.7, 0.2-0.8): the node's fan is the marks' two parts
+  // wherever it lies (closed_marks.hpp; stop 53). Issue 9's 200 shifted strokes with both:
+  // 149 -> 159 within the Hausdorff tolerance, summed excess 14.24 -> 9.87.
+  bool opening_split_shift = true;
   // How many times the stroke's end splits again what opened walls still hold shut (closed_marks
   // .hpp; each round only while the last opened more).
   int opening_rounds = 2;

@@ -463,6 +463,35 @@ TEST(CutFidelity, TheTipsCornerFillsAtAStrokesEnd) {
   EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
 }
 
+// CutOptions::open_marks_at_input_scale (cutting/closed_marks.hpp): a closed mark split small
+// near the tip's path counts as along the blade's sweep at the scale of the input tet it came
+// from, so the stroke's end opens it. The fine liver's curved vertical 3 mm stroke: a closed
+// mark 1 mm below the tip's path left a hole 1.78 mm across (1.26 x the tolerance) without,
+// 1.40 mm with (its faces' 1.26 x, a corner at the skin, stays); over issue 9's 200 shifted
+// strokes 149 -> 156 within the tolerance.
+TEST(CutFidelity, ClosedMarksAtTheTipsPathOpen) {
+  const OnAndOff r = on_and_off(
+      "liver-50000", 0, 3e-3, true, [](CutOptions& o) { o.open_marks_at_input_scale = false; },
+      "marks at the input's scale", "marks at their own scale");
+  EXPECT_LE(r.on.f.sweep_to_faces, 0.85 * r.off.f.sweep_to_faces) << r.on.line << "\n"
+                                                                  << r.off.line;
+  EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
+}
+
+// CutOptions::opening_split_shift: an opening split the guard refuses at an edge's midpoint is
+// made at the nearest place it allows. The fine liver's straight vertical slow stroke: without
+// it, the marks admitted at the input's scale split an edge that stayed shut and held a
+// neighbour shut (1.06 x the tolerance); with it 0.90 x.
+TEST(CutFidelity, OpeningSplitsMoveAlongTheirEdge) {
+  const OnAndOff r = on_and_off(
+      "liver-50000", 0, 0.2e-3, false, [](CutOptions& o) { o.opening_split_shift = false; },
+      "opening splits moved", "opening splits at midpoints");
+  EXPECT_LE(r.on.f.hausdorff_over_tolerance, r.off.f.hausdorff_over_tolerance - 0.1)
+      << r.on.line << "\n"
+      << r.off.line;
+  expect_issue_targets(r.on, r.stroke);
+}
+
 // A tilted blade's stroke opens from where it starts: the faces that straddle its start are
 // refused while the blade is short of their far corners (CutOptions::front_corner_reach) and
 // tested again as it moves on (mark_deferred_faces), and a node snapped onto the plane past the
