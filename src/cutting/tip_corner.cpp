@@ -4,6 +4,7 @@
 #include "cutting/triangle_cut.hpp"
 #include "cutting/vertex_insertion.hpp"
 #include "soft_tissue_cutting/collision/blade.hpp"
+#include "soft_tissue_cutting/collision/tet_locator.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -23,14 +24,9 @@ constexpr int kMaxGrowth = 4;
 
 bool holds_point(const TetMesh& mesh, int t, const Vec3& p) {
   const Tet& k = mesh.tets[static_cast<size_t>(t)];
-  const Vec3* x[4] = {&mesh.nodes[k[0]], &mesh.nodes[k[1]], &mesh.nodes[k[2]], &mesh.nodes[k[3]]};
-  const double v = signed_volume(*x[0], *x[1], *x[2], *x[3]);
-  for (int i = 0; i < 4; ++i) {
-    const Vec3* y[4] = {x[0], x[1], x[2], x[3]};
-    y[i] = &p;
-    if (signed_volume(*y[0], *y[1], *y[2], *y[3]) < -1e-9 * v) return false;
-  }
-  return true;
+  const std::array<double, 4> w =
+      barycentric(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]], mesh.nodes[k[3]], p);
+  return std::all_of(w.begin(), w.end(), [](double x) { return x >= -1e-9; });  // NaN: flat
 }
 
 // A border edge (a, b) of the cut facing the tip, the triangle (tip, a, b) filling the corner

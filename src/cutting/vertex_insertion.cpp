@@ -1,6 +1,7 @@
 #include "cutting/vertex_insertion.hpp"
 
 #include "cutting/triangle_cut.hpp"
+#include "soft_tissue_cutting/collision/tet_locator.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
 #include <algorithm>
@@ -144,13 +145,8 @@ bool tiles_and_locate(const TetMesh& mesh, const Vec3& x, double volume,
   double inside = -1e300;
   for (int c : insertion.cavity) {
     const Tet& k = mesh.tets[static_cast<size_t>(c)];
-    const double v = tet_volume(mesh, c);
-    std::array<double, 4> w{};
-    for (int i = 0; i < 4; ++i) {
-      Tet sub = k;
-      sub[static_cast<size_t>(i)] = kInsertedNode;
-      w[static_cast<size_t>(i)] = volume_with(mesh, sub, x) / v;
-    }
+    const std::array<double, 4> w =
+        barycentric(mesh.nodes[k[0]], mesh.nodes[k[1]], mesh.nodes[k[2]], mesh.nodes[k[3]], x);
     if (const double least = *std::min_element(w.begin(), w.end()); least > inside)
       inside = least, insertion.host = k, insertion.weights = w;
   }
