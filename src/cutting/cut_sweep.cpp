@@ -80,15 +80,24 @@ void extend_path(std::vector<Vec3>& path, std::vector<Vec3>& past, const Vec3& x
 }
 
 // The stroke's tip and heel paths as limits (CutOptions::path_corner_reach), if set.
+// And where the stroke started (CutOptions::start_corner_limit): a corner at most its own slack
+// behind it, at the skin too.
 void add_path_limits(const CutState& state, const CutOptions& options, double margin,
                      std::vector<BladeStop>& stops) {
-  if (options.path_corner_reach < 0 || options.path_corner_slack < 0) return;
-  for (const auto* path : {&state.tip_path, &state.heel_path}) {
+  if (options.path_corner_reach >= 0 && options.path_corner_slack >= 0)
+    for (const auto* path : {&state.tip_path, &state.heel_path}) {
+      BladeStop stop;
+      stop.line = *path;
+      stop.past = path == &state.tip_path ? state.tip_past : state.heel_past;
+      stop.reach = options.path_corner_reach * margin;
+      stop.slack_fraction = options.path_corner_slack;
+      stops.push_back(std::move(stop));
+    }
+  if (options.start_corner_limit && !state.start_line.empty()) {
     BladeStop stop;
-    stop.line = *path;
-    stop.past = path == &state.tip_path ? state.tip_past : state.heel_past;
-    stop.reach = options.path_corner_reach * margin;
-    stop.slack_fraction = options.path_corner_slack;
+    stop.line = state.start_line;
+    stop.past = state.start_past;
+    stop.slack_fraction = 1;
     stops.push_back(std::move(stop));
   }
 }
@@ -341,6 +350,12 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   if (!continues) {
     state.tip_path.clear(), state.tip_past.clear();
     state.heel_path.clear(), state.heel_past.clear();
+    state.start_line = a;
+    state.start_past.clear();
+    for (size_t i = 0; i < a.size(); ++i) {
+      const Vec3 motion = to[i] - from[i];
+      state.start_past.push_back(motion.norm() > 0 ? Vec3(-motion.normalized()) : Vec3::Zero());
+    }
   }
   const auto past_end = [](const Vec3& end, const Vec3& next) {
     const Vec3 d = end - next;

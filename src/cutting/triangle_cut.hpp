@@ -111,7 +111,7 @@ class StrokeSurface {
     // How far x lies past the line (along its nearest point's direction; < 0 short of it).
     double past_of(const Vec3& x) const;
   };
-  static constexpr size_t kMaxLimits = 3;  // the edge's front, the tip's path, the heel's
+  static constexpr size_t kMaxLimits = 4;  // the edge's front, the tip's and heel's paths, the start
 
   std::vector<std::array<Vec3, 3>> triangles_;
   std::vector<Vec3> lo_, hi_;
@@ -121,9 +121,9 @@ class StrokeSurface {
   struct Known {
     double near_at = std::numeric_limits<double>::infinity(), far_below = -1;
     // How far past each limit's line (NaN: not asked yet).
-    std::array<double, kMaxLimits> past = {std::numeric_limits<double>::quiet_NaN(),
-                                           std::numeric_limits<double>::quiet_NaN(),
-                                           std::numeric_limits<double>::quiet_NaN()};
+    std::array<double, kMaxLimits> past = {
+        std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+        std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
     std::int8_t on_boundary = -1;  // -1: not asked yet
   };
   std::unordered_map<int, Known> known_;
