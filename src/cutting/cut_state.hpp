@@ -70,10 +70,12 @@ struct CutState {
   // newest always) and the way past each point (unit: down the blade past the tip, up past the
   // heel): a marked face's corner may lie only a little past them (cut_sweep.cpp).
   std::vector<Vec3> tip_path, tip_past, heel_path, heel_past;
-  // Where the stroke started (its first band's back edge, margins below the tip and above the
-  // heel included) and the way back past it (unit: against the first step's motion): a marked
-  // face's corner, at the skin too, may lie at most its slack behind it (cut_sweep.cpp).
+  // Where the stroke started (the back edge of its first band that moves across the blade's
+  // edge - a blade pressed in first moves along it -, margins below the tip and above the heel
+  // included) and the way back past it (unit: against that band's motion across the edge): a
+  // marked face's corner, at the skin too, may lie at most its slack behind it (cut_sweep.cpp).
   std::vector<Vec3> start_line, start_past;
+  bool start_limited = false;  // not where a stroke begins inside the last one's incision
   double stroke_margin = 0;  // the last band's margin (CutOptions::front_margin)
   // Faces the stroke's cuts refused only because a corner lay past the blade, tested again
   // by its later cuts (mark_deferred_faces, triangle_cut.hpp).

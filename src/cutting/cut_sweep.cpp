@@ -1,5 +1,6 @@
 #include "cutting/cut_sweep.hpp"
 
+#include "collision/tissue_samples.hpp"
 #include "cutting/closed_marks.hpp"
 #include "cutting/cut_smoothing.hpp"
 #include "cutting/earlier_triangles.hpp"
@@ -101,6 +102,12 @@ void add_path_limits(const CutState& state, const CutOptions& options, double ma
     stops.push_back(std::move(stop));
   }
 }
+
+// A band moves across the blade's edge (CutState::start_line) where at least this share of
+// every point's motion is across it (0.5: at most 60 deg off the edge's normal).
+constexpr double kAcrossShare = 0.5;
+// Points per segment of the stroke's start edge tested for tissue behind them.
+constexpr int kStartSamples = 8;
 
 // At most this many faces wait (CutState::deferred_faces); the oldest go first.
 constexpr size_t kMaxDeferredFaces = 4096;
@@ -350,11 +357,42 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
   if (!continues) {
     state.tip_path.clear(), state.tip_past.clear();
     state.heel_path.clear(), state.heel_past.clear();
-    state.start_line = a;
-    state.start_past.clear();
-    for (size_t i = 0; i < a.size(); ++i) {
+    state.start_line.clear(), state.start_past.clear();
+    // A stroke that begins inside the last one's incision (the blade cuts on after a stroke
+    // ended: a region move carried its rest edge a little off the last one's) has that cut
+    // behind it, whose faces it may still open.
+    bool in_incision = !state.blade_sweep.empty();
+    const StrokeSurface last(state.blade_sweep);
+    for (const Vec3& x : from) in_incision = in_incision && last.near(x, margin);
+    state.start_limited = !in_incision;
+  }
+  // Where the stroke starts moving across the blade's edge (a blade pressed in first moves
+  // along it, and what lies above its heel then is not behind it): behind is against that
+  // motion.
+  if (state.start_limited && state.start_line.empty()) {
+    const Vec3 edge = (from.back() - from.front()).normalized();
+    std::vector<Vec3> behind;
+    for (size_t i = 0; i < from.size(); ++i) {
       const Vec3 motion = to[i] - from[i];
-      state.start_past.push_back(motion.norm() > 0 ? Vec3(-motion.normalized()) : Vec3::Zero());
+      const Vec3 across = motion - motion.dot(edge) * edge;
+      if (!(across.norm() >= kAcrossShare * motion.norm() && motion.norm() > 0)) break;
+      behind.push_back(-across.normalized());
+    }
+    if (behind.size() == from.size()) {
+      // Only where there is tissue behind the blade's edge as it starts: a blade that comes
+      // in from outside (through the tissue's side, slicing a lobe) passed the skin behind its
+      // first band, and the faces there must open or the slice leaves the piece attached.
+      for (size_t i = 0; i + 1 < a.size(); ++i)
+        for (int k = 0; k <= kStartSamples; ++k) {
+          if (k == kStartSamples && i + 2 < a.size()) continue;  // the next segment's first
+          const double u = static_cast<double>(k) / kStartSamples;
+          const Vec3 x = (1 - u) * a[i] + u * a[i + 1];
+          const Vec3 way = ((1 - u) * behind[i] + u * behind[i + 1]).normalized();
+          if (tet_containing(mesh, state.grid, x) >= 0 &&
+              tet_containing(mesh, state.grid, x + margin * way) >= 0)
+            state.start_line.push_back(x), state.start_past.push_back(way);
+        }
+      state.start_limited = !state.start_line.empty();
     }
   }
   const auto past_end = [](const Vec3& end, const Vec3& next) {

@@ -142,12 +142,15 @@ struct CutOptions {
   // blade moves on (docs/DESIGN.md section 8, "Mark"). Negative: no limit.
   double path_corner_reach = 1.0;
   double path_corner_slack = 0.25;
-  // And behind where the stroke started (against its first step's motion): each corner at most
-  // its slack, a corner on the tissue's boundary too (whose slack from the stroke's surface is
+  // And behind where the stroke started inside the tissue (against its first motion across the
+  // blade's edge, where there is tissue behind the edge): each corner at most its slack, a
+  // corner on the tissue's boundary too (whose slack from the stroke's surface is
   // kSkinCornerSlack times larger in every other direction: the skin is where the blade's edge
   // is extrapolated across it, which moves the surface off its plane, not back past its start).
   // Without it a curved tilted stroke on the 50k liver opened a face with a skin corner 3.2 mm
-  // behind its start (2.27 x the Hausdorff tolerance; docs/DESIGN.md section 8, "Mark").
+  // behind its start (2.27 x the Hausdorff tolerance; docs/DESIGN.md section 8, "Mark"). Not
+  // where the blade came in from outside (the skin behind its first band is tissue it passed),
+  // nor where a stroke begins inside the last one's incision.
   bool start_corner_limit = true;
   // Where the band is conformed along the tip's path (eq. (19a)), an edge with an end this
   // fraction of the snap distance (snap_tolerance x its star's longest edge) off the band's
