@@ -493,10 +493,12 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
       int nearest = -1;
       double best = 2.0;
       bool outside = false;
+      Vec3 crossing_at = Vec3::Zero();
       for (const Split& s : splits) {
         const bool beyond_here = beyond.count({s.a, s.b}) > 0;
-        if (s.t < best) best = s.t, nearest = s.a, outside = beyond_here;
-        if (1 - s.t < best) best = 1 - s.t, nearest = s.b, outside = beyond_here;
+        const Vec3 at = mesh.nodes[s.a] + s.t * (mesh.nodes[s.b] - mesh.nodes[s.a]);
+        if (s.t < best) best = s.t, nearest = s.a, outside = beyond_here, crossing_at = at;
+        if (1 - s.t < best) best = 1 - s.t, nearest = s.b, outside = beyond_here, crossing_at = at;
       }
       // Or move one crossing along its edge where that puts its new node nearer the plane
       // than the snapped end lies (docs/DESIGN.md section 8 "Shape guard", eq. (20d)).
@@ -506,6 +508,22 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         shifted[shift.edge] = shift.to - crossing[shift.edge];
         crossing[shift.edge] = shift.to;
         snapped = true;  // round again: every tet is checked with the moved crossing
+        continue;
+      }
+      // Or move the end onto the plane where it may (relocate_node): snapped in place it would
+      // lie up to half an edge off the blade, and so would the faces that open on it.
+      if (options.relocate_refused && std::abs(tri.distance(mesh, nearest)) > 0 &&
+          best > kNegligibleMove &&
+          (relocate_node(mesh, state, nearest, crossing_at, options, result) ||
+           relocate_node(mesh, state, nearest,
+                         mesh.nodes[nearest] - tri.distance(mesh, nearest) * tri.normal(), options,
+                         result))) {
+        tri.set_on(nearest);
+        if (!outside)
+          set_on_stroke(state, nearest);
+        else
+          set_on_extension(state, nearest);
+        snapped = true;
         continue;
       }
       tri.set_on(nearest);

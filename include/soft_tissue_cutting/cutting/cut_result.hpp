@@ -51,6 +51,10 @@ struct CutOptions {
   // node keeps the total volume exactly (its star still tiles the same cavity).
   double relocate = 0.3;
   double relocate_min_dihedral_deg = 10.0;
+  // Where the guards refuse a split and no move along the edge passes (eq. (20d)), the end
+  // nearest the plane is moved onto it if it may (as a relocation, whatever its t) instead of
+  // snapped in place up to half an edge off the blade.
+  bool relocate_refused = true;
   // When a new stroke begins, the nodes of the tets the last stroke left with a smallest
   // dihedral angle below this (degrees) are moved to raise it where no surface moves: inside
   // their stars, or within a flat cut wall (cutting/cut_smoothing.hpp). 0: off.
