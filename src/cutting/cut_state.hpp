@@ -76,7 +76,7 @@ struct CutState {
   // marked face's corner, at the skin too, may lie at most its slack behind it (cut_sweep.cpp).
   std::vector<Vec3> start_line, start_past;
   bool start_limited = false;  // not where a stroke begins inside the last one's incision
-  double stroke_margin = 0;  // the last band's margin (CutOptions::front_margin)
+  double stroke_margin = 0;    // the last band's margin (CutOptions::front_margin)
   // Faces the stroke's cuts refused only because a corner lay past the blade, tested again
   // by its later cuts (mark_deferred_faces, triangle_cut.hpp).
   std::vector<std::array<int, 3>> deferred_faces;

@@ -111,7 +111,8 @@ class StrokeSurface {
     // How far x lies past the line (along its nearest point's direction; < 0 short of it).
     double past_of(const Vec3& x) const;
   };
-  static constexpr size_t kMaxLimits = 4;  // the edge's front, the tip's and heel's paths, the start
+  // The edge's front, the tip's and heel's paths, the stroke's start.
+  static constexpr size_t kMaxLimits = 4;
 
   std::vector<std::array<Vec3, 3>> triangles_;
   std::vector<Vec3> lo_, hi_;
