@@ -143,8 +143,8 @@ class Simulation {
   void cut_path_slice(PathCut& cut, std::chrono::steady_clock::time_point deadline);
   // Counts of the finished (or refused) cut and the true reason when nothing was cut.
   CutOutcome finish_path_cut(const PathCut& cut) const;
-  // Spacing (m) at which cut paths are resampled: the median edge of the initial operation
-  // part.
+  // Spacing (m) at which cut paths are resampled: 0.3 of the median edge of the initial
+  // operation part (simulation.cpp, kPathSpacingFraction).
   double cut_path_spacing() const;
   // Back to the initial mesh and state, identical to a fresh start.
   void reset();

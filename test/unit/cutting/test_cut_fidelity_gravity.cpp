@@ -159,11 +159,13 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
   // (before the blade was carried to rest coordinates they lay 25 mm off it, where the rest
   // mesh was), and item 1 holds on the sagged liver: 124 % opened, 100 % covered (stop 28:
   // faces may reach three quarters of the front margin past the blade, not all of it - 75 % / 85 %
-  // before). The open faces reach 1.09 x the tolerance past the sweep, 2.9 mm under the tip's path:
-  // a face opens when its corners lie within a quarter of its longest edge of the blade's path, and
-  // there its longest edge (12 mm) is longer than the mean edge the tolerance is taken from (10.6
-  // mm): issue 9 item 2 is missed here by 9 %, asserted with that (README).
-  EXPECT_LE(f.faces_over_tolerance, 1.1) << line.str();
+  // before). The open faces lie within the tolerance of the blade's path (measured 0.86 x) since
+  // the path is cut in bands of 0.3 instead of 1 median edge (stop 54; 1.08 x before: a band a
+  // whole edge long, planar in rest coordinates, lay off the blade's surface mapped there). The
+  // two-sided distance: 1.06 x (1.51 x before: no face opened within 1 mm of the sweep over its
+  // first 3 mm).
+  EXPECT_LE(f.faces_over_tolerance, 1.0) << line.str();
+  EXPECT_LE(f.hausdorff_over_tolerance, 1.2) << line.str();
   EXPECT_GE(f.wall_alignment, 0.95) << line.str();
   EXPECT_GE(f.opening(), 0.9) << line.str();
   EXPECT_GE(f.covered_area, 0.99 * f.swept_area) << line.str();
