@@ -149,8 +149,9 @@ TEST(CutPathSampling, RepeatedCutSaysItIsAlreadyCut) {
   // up to snap * edge off the blade, and each pass carries the path to rest coordinates
   // through the tissue opened by the last); it settles within a few passes (measured: 3 until
   // stop 46; 4 since faces past the blade wait for it, 31 / 6 / 2 / 0 faces; 5 since the 5 deg
-  // guard moves crossings along their edges, stop 51: 38 / 25 / 4 / 2 / 0), and then the reply
-  // names the true reason instead of "does not cross".
+  // guard moves crossings along their edges, stop 51: 38 / 25 / 4 / 2 / 0; 4 since paths are
+  // cut in bands of 0.3 median edge, stop 54: 52 / 4 / 0), and then the reply names the true
+  // reason instead of "does not cross".
   CutOutcome again;
   int passes = 0;
   do {
