@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace stc {
 namespace {
@@ -186,6 +187,44 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
   out.hausdorff = std::max(out.faces_to_sweep, out.sweep_to_faces);
   out.hausdorff_over_tolerance = std::max(out.hausdorff_over_tolerance, out.faces_over_tolerance);
   return out;
+}
+
+bool dump_cut(const char* path, const TetMesh& mesh, const std::vector<SweptTriangle>& sweep,
+              const Vec3& origin, const Vec3& direction, const Vec3& up, bool tets) {
+  FILE* f = std::fopen(path, "w");
+  if (f == nullptr) return false;
+  const Vec3 aside = up.cross(direction);
+  auto point = [&](const Vec3& x) {
+    const Vec3 w = x - origin;
+    std::fprintf(f, " %.6g %.6g %.6g", 1e3 * w.dot(direction), 1e3 * w.dot(up), 1e3 * w.dot(aside));
+  };
+  for (const SweptTriangle& t : sweep) {
+    std::fprintf(f, "S");
+    for (const Vec3& x : t.x) point(x);
+    std::fprintf(f, "\n");
+  }
+  for (const BoundaryTriangle& t : extract_boundary_surface(mesh).triangles) {
+    if (!t.cut) continue;
+    std::fprintf(f, "C");
+    for (int n : t.nodes) point(mesh.nodes[static_cast<size_t>(n)]);
+    std::fprintf(f, "\n");
+  }
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    for (int k = 0; k < 4; ++k)
+      if (mesh.is_cut_face(t, k)) {
+        std::fprintf(f, "M");
+        for (int j = 0; j < 4; ++j)
+          if (j != k) point(mesh.nodes[static_cast<size_t>(mesh.tets[t][j])]);
+        std::fprintf(f, "\n");
+      }
+  if (tets)
+    for (int t = 0; t < mesh.num_tets(); ++t) {
+      std::fprintf(f, "T");
+      for (int n : mesh.tets[t]) std::fprintf(f, " %d", n);
+      for (int n : mesh.tets[t]) point(mesh.nodes[static_cast<size_t>(n)]);
+      std::fprintf(f, "\n");
+    }
+  return std::fclose(f) == 0;
 }
 
 }  // namespace stc

@@ -75,4 +75,12 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& cu
 // Distance from p to triangle (a, b, c).
 double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+// Writes, for a plot of where a cut's holes are (STC_FIDELITY_DUMP in the fidelity tests), one
+// line per sweep triangle (S), open cut face (C, boundary triangles marked cut) and marked face
+// (M), and with `tets` every tet (T: its four nodes, then their positions), each point in mm
+// along `direction`, along `up` and along up x direction from `origin`. False if `path` cannot
+// be written.
+bool dump_cut(const char* path, const TetMesh& mesh, const std::vector<SweptTriangle>& sweep,
+              const Vec3& origin, const Vec3& direction, const Vec3& up, bool tets);
+
 }  // namespace stc

@@ -120,41 +120,9 @@ Figures run_stroke(Bench& b, const Stroke& s, const std::string& label) {
   // STC_FIDELITY_DUMP=FILE: the sweep triangles (S), open cut faces (C) and marked faces (M),
   // in mm along / up / aside from the stroke's centre, for a plot of where the holes are.
   // STC_FIDELITY_DUMP_TETS=1 adds every tet (T, its four nodes and their positions).
-  if (const char* dump = std::getenv("STC_FIDELITY_DUMP")) {
-    FILE* f = std::fopen(dump, "w");
-    auto proj = [&](const Vec3& x) {
-      const Vec3 w = x - s.centre;
-      std::fprintf(f, " %.6g %.6g %.6g", 1e3 * w.dot(s.direction), 1e3 * w.dot(s.up),
-                   1e3 * w.dot(s.up.cross(s.direction)));
-    };
-    for (const auto& t : sweep) {
-      std::fprintf(f, "S");
-      for (int k = 0; k < 3; ++k) proj(t.x[k]);
-      std::fprintf(f, "\n");
-    }
-    for (const BoundaryTriangle& tri : extract_boundary_surface(b.mesh).triangles) {
-      if (!tri.cut) continue;
-      std::fprintf(f, "C");
-      for (int k = 0; k < 3; ++k) proj(b.mesh.nodes[tri.nodes[k]]);
-      std::fprintf(f, "\n");
-    }
-    for (int t = 0; t < b.mesh.num_tets(); ++t)
-      for (int k = 0; k < 4; ++k)
-        if (b.mesh.is_cut_face(t, k)) {
-          std::fprintf(f, "M");
-          for (int j = 0; j < 4; ++j)
-            if (j != k) proj(b.mesh.nodes[b.mesh.tets[t][j]]);
-          std::fprintf(f, "\n");
-        }
-    if (std::getenv("STC_FIDELITY_DUMP_TETS"))
-      for (int t = 0; t < b.mesh.num_tets(); ++t) {
-        std::fprintf(f, "T");
-        for (int j = 0; j < 4; ++j) std::fprintf(f, " %d", b.mesh.tets[t][j]);
-        for (int j = 0; j < 4; ++j) proj(b.mesh.nodes[b.mesh.tets[t][j]]);
-        std::fprintf(f, "\n");
-      }
-    std::fclose(f);
-  }
+  if (const char* dump = std::getenv("STC_FIDELITY_DUMP"))
+    dump_cut(dump, b.mesh, sweep, s.centre, s.direction, s.up,
+             std::getenv("STC_FIDELITY_DUMP_TETS") != nullptr);
   out.f = measure_cut_fidelity(*b.region, b.mesh, sweep, 0.25e-3);
   if (s.step > 1e-3) {
     // A step's two triangles (add_sweep).

@@ -90,43 +90,11 @@ TEST(CutFidelityGravity, CutWallsLieOnTheBladePathInTheSaggedLiver) {
        << 1e3 * (f.worst_face_point - top).dot(s.up) << " mm up, "
        << 1e3 * (f.worst_face_point - top).dot(s.direction.cross(s.up)) << " mm aside";
   std::printf("FIDELITY %s\n", line.str().c_str());
-  // STC_FIDELITY_DUMP=FILE: the sweep (S), the carried open cut faces (C) and the carried marked
-  // faces (M) in mm along / up / aside from the rest top, as the matrix's dump.
-  if (const char* dump = std::getenv("STC_FIDELITY_DUMP")) {
-    FILE* out_file = std::fopen(dump, "w");
-    auto proj = [&](const Vec3& x) {
-      const Vec3 w = x - top;
-      std::fprintf(out_file, " %.6g %.6g %.6g", 1e3 * w.dot(s.direction), 1e3 * w.dot(s.up),
-                   1e3 * w.dot(s.up.cross(s.direction)));
-    };
-    for (const SweptTriangle& t : sweep) {
-      std::fprintf(out_file, "S");
-      for (int k = 0; k < 3; ++k) proj(t.x[k]);
-      std::fprintf(out_file, "\n");
-    }
-    for (const BoundaryTriangle& t : extract_boundary_surface(carried).triangles) {
-      if (!t.cut) continue;
-      std::fprintf(out_file, "C");
-      for (int k = 0; k < 3; ++k) proj(carried.nodes[t.nodes[k]]);
-      std::fprintf(out_file, "\n");
-    }
-    for (int t = 0; t < carried.num_tets(); ++t)
-      for (int k = 0; k < 4; ++k)
-        if (carried.is_cut_face(t, k)) {
-          std::fprintf(out_file, "M");
-          for (int j = 0; j < 4; ++j)
-            if (j != k) proj(carried.nodes[carried.tets[t][j]]);
-          std::fprintf(out_file, "\n");
-        }
-    if (std::getenv("STC_FIDELITY_DUMP_TETS"))
-      for (int t = 0; t < carried.num_tets(); ++t) {
-        std::fprintf(out_file, "T");
-        for (int j = 0; j < 4; ++j) std::fprintf(out_file, " %d", carried.tets[t][j]);
-        for (int j = 0; j < 4; ++j) proj(carried.nodes[carried.tets[t][j]]);
-        std::fprintf(out_file, "\n");
-      }
-    std::fclose(out_file);
-  }
+  // STC_FIDELITY_DUMP=FILE (and STC_FIDELITY_DUMP_TETS=1): the sweep and the carried cut, in mm
+  // along / up / aside from the rest top, as the matrix's dump (dump_cut).
+  if (const char* dump = std::getenv("STC_FIDELITY_DUMP"))
+    dump_cut(dump, carried, sweep, top, s.direction, s.up,
+             std::getenv("STC_FIDELITY_DUMP_TETS") != nullptr);
   // STC_MAP=1: a map of the swept surface (rows: mm above the tip path's surface level;
   // columns: mm along) - '#' within 1 mm of an open face, '+' within 3 mm, '.' farther.
   if (std::getenv("STC_MAP")) {
