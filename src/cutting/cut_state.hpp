@@ -75,8 +75,10 @@ struct CutState {
   // included) and the way back past it (unit: against that band's motion across the edge): a
   // marked face's corner, at the skin too, may lie at most its slack behind it (cut_sweep.cpp).
   std::vector<Vec3> start_line, start_past;
-  bool start_limited = false;  // not where a stroke begins inside the last one's incision
-  double stroke_margin = 0;    // the last band's margin (CutOptions::front_margin)
+  // The start line is still to be found (the stroke has not yet moved across the blade's edge);
+  // never for a stroke that begins inside the last one's incision.
+  bool start_pending = false;
+  double stroke_margin = 0;  // the last band's margin (CutOptions::front_margin)
   // Faces the stroke's cuts refused only because a corner lay past the blade, tested again
   // by its later cuts (mark_deferred_faces, triangle_cut.hpp).
   std::vector<std::array<int, 3>> deferred_faces;

@@ -364,12 +364,12 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
     bool in_incision = !state.blade_sweep.empty();
     const StrokeSurface last(state.blade_sweep);
     for (const Vec3& x : from) in_incision = in_incision && last.near(x, margin);
-    state.start_limited = !in_incision;
+    state.start_pending = !in_incision;
   }
   // Where the stroke starts moving across the blade's edge (a blade pressed in first moves
   // along it, and what lies above its heel then is not behind it): behind is against that
   // motion.
-  if (state.start_limited && state.start_line.empty()) {
+  if (state.start_pending) {
     const Vec3 edge = (from.back() - from.front()).normalized();
     std::vector<Vec3> behind;
     for (size_t i = 0; i < from.size(); ++i) {
@@ -392,7 +392,7 @@ CutResult cut_band(TetMesh& mesh, CutState& state, const std::vector<Vec3>& from
               tet_containing(mesh, state.grid, x + margin * way) >= 0)
             state.start_line.push_back(x), state.start_past.push_back(way);
         }
-      state.start_limited = !state.start_line.empty();
+      state.start_pending = false;
     }
   }
   const auto past_end = [](const Vec3& end, const Vec3& next) {

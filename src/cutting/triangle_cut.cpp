@@ -220,6 +220,18 @@ Shift nearest_shift(const TetMesh& mesh, const CutState& state, const TriangleCl
   return best;
 }
 
+// Node v is on triangle `tri`'s cut now: snapped in place (moved false) or moved exactly onto
+// its plane. A node moved there beyond the triangle (`outside`: an edge of a tet the whole plane
+// cuts) is on the surface's extension for the stroke's later triangles (cut_state.hpp); any
+// other is on the stroke.
+void take_onto_cut(TriangleClassification& tri, CutState& state, int v, bool moved, bool outside) {
+  tri.set_on(v);
+  if (!outside || !moved)
+    set_on_stroke(state, v);
+  else
+    set_on_extension(state, v);
+}
+
 // Moves node v to `target` if v is an interior, unlocked node of the operation part that no
 // marked face touches, and its star keeps positive volume above the size guard and a smallest
 // dihedral angle no worse than min(limit, the star's current one). Returns whether it moved.
@@ -453,11 +465,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
         // of its other corners - is never found again (a 3.7 mm hole at the thigh's start). How
         // far past the border such a face may reach is the corner tests' to say (corner_near).
         auto put_on = [&](int node, bool moved) {
-          tri.set_on(node);
-          if (!outside || !moved)
-            set_on_stroke(state, node);
-          else
-            set_on_extension(state, node);
+          take_onto_cut(tri, state, node, moved, outside);
         };
         // Too near an end: that end is on the cut (snapped, never moved), so every edge that
         // is split has t in [snap, 1 - snap].
@@ -518,11 +526,7 @@ void split_along_triangle(TetMesh& mesh, CutState& state, TriangleClassification
            relocate_node(mesh, state, nearest,
                          mesh.nodes[nearest] - tri.distance(mesh, nearest) * tri.normal(), options,
                          result))) {
-        tri.set_on(nearest);
-        if (!outside)
-          set_on_stroke(state, nearest);
-        else
-          set_on_extension(state, nearest);
+        take_onto_cut(tri, state, nearest, true, outside);
         snapped = true;
         continue;
       }
