@@ -164,6 +164,17 @@ struct CutOptions {
   // tilted slow stroke). Not along the heel's path (no stroke of the fidelity matrix gains; the
   // coarse liver's belly cut opens 152 % of its sweep). docs/DESIGN.md section 8 "Borders". 0: off.
   double path_border_snap = 0.75;
+  // Where the band is conformed along the tip's path (eq. (19a)), an edge crosses the border
+  // where its ends lie on either side of the path the tip took (CutState::tip_path: the blade's
+  // tip without the band's margin; "past" it is down the blade), not of the line through the
+  // band's border segment. That segment runs from the last band's margin-extended tip to this
+  // one's: the border lay a front margin (a quarter of the mean edge) below the tip, so the faces
+  // reached that far past it (the thigh's straight vertical stroke: 2.56 mm, 0.90 x the Hausdorff
+  // tolerance, everywhere along its tip), and a slow stroke's segment is one 0.2 mm step while
+  // the tip's rest position moves up to 0.3 mm up or down between steps (the stroke follows the
+  // faceted skin), so the line's direction was noise. Issue 9's matrix at five positions: 163 ->
+  // 169 of 200 strokes within the Hausdorff tolerance (docs/DESIGN.md section 8 "Borders").
+  bool tip_border_on_path = true;
   // At a stroke's end (finish_stroke) the last band reached back a front margin along its
   // motion is cut and marked with it, so the faces the front's split makes behind a slow
   // stroke's one-step band open (over issue 9's 200 shifted matrix strokes the summed excess over
