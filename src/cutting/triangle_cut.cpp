@@ -625,8 +625,27 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   // Which side of the border a point lies on, and whether it lies along it: past the tip's path
   // (CutOptions::tip_border_on_path) or across the segment's line in the triangle's plane.
   const bool on_path = tip_path && options.tip_border_on_path && state.tip_path.size() >= 2;
+  const std::vector<int> candidates =
+      cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
+  // The path's last stretch, as far back as twice the candidates' longest edge: their edges'
+  // crossings lie there, and a long stroke's whole path (up to kMaxStrokeTriangles points)
+  // would be searched for every end of every edge at every band.
+  std::vector<Vec3> path, way;
+  if (on_path) {
+    double reach = 0;
+    for (int t : candidates)
+      for (const auto& e : kTetEdges)
+        reach = std::max(reach,
+                         (mesh.nodes[mesh.tets[t][e[0]]] - mesh.nodes[mesh.tets[t][e[1]]]).norm());
+    reach = 2 * reach + std::sqrt(length2);
+    size_t first = state.tip_path.size() - 1;
+    for (double walked = 0; first > 0 && walked <= reach; --first)
+      walked += (state.tip_path[first] - state.tip_path[first - 1]).norm();
+    path.assign(state.tip_path.begin() + static_cast<long>(first), state.tip_path.end());
+    way.assign(state.tip_past.begin() + static_cast<long>(first), state.tip_past.end());
+  }
   auto past_border = [&](const Vec3& x, bool* along) {
-    if (on_path) return past_polyline(state.tip_path, state.tip_past, x, 0.0, along);
+    if (on_path) return past_polyline(path, way, x, 0.0, along);
     if (along) *along = along_segment(x);
     return across.dot(x - p0);
   };
@@ -638,8 +657,6 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
     const double snap = options.snap_tolerance * star_longest_edge(mesh, state, v);
     return (tip_path && d <= options.path_border_snap * snap) || (extension && d <= snap);
   };
-  const std::vector<int> candidates =
-      cuttable_tets_in(mesh, state, p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad);
   std::map<std::pair<int, int>, double> crossing;
   for (int t : candidates) {
     const Tet& tet = mesh.tets[t];
