@@ -617,11 +617,7 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
   }
   std::sort(whole.begin(), whole.end());
   if (!whole.empty()) split_along_triangle(mesh, state, tri, options, result, whole);
-  // (b) The edges on the cut that cross the segment. An end on the surface's extension past
-  // a border is on it as a node on the stroke is: within the snap distance of this triangle's
-  // plane (a curved stroke's earlier triangle, at a slight angle to this one, took it there).
-  // Along the tip's path, a node near the plane is taken as on it too
-  // (CutOptions::path_border_snap: between a curved stroke's bands it is on neither).
+  // (b) The edges on the cut that cross the border.
   // Which side of the border a point lies on, and whether it lies along it: past the tip's path
   // (CutOptions::tip_border_on_path) or across the segment's line in the triangle's plane.
   const bool on_path = tip_path && options.tip_border_on_path && state.tip_path.size() >= 2;
@@ -649,6 +645,11 @@ void split_along_border(TetMesh& mesh, CutState& state, TriangleClassification& 
     if (along) *along = along_segment(x);
     return across.dot(x - p0);
   };
+  // An end on the surface's extension past a border is on it as a node on the stroke is:
+  // within the snap distance of this triangle's plane (a curved stroke's earlier triangle, at a
+  // slight angle to this one, took it there). Along the tip's path, a node near the plane is
+  // taken as on it too (CutOptions::path_border_snap: between a curved stroke's bands it is on
+  // neither).
   auto on_cut_or_extension = [&](int v) {
     if (tri.side(mesh, state, v) == 0) return true;
     const bool extension = is_on_extension(state, v);

@@ -121,9 +121,11 @@ struct Simulation::Impl {
 
   Backend requested_backend() const { return options.backend.value_or(scene.solver.backend); }
 
-  // ~cut paths are resampled at this spacing (docs/DESIGN.md (cutting)): the median edge of
-  // the initial operation part, so one sweep per element size whatever the caller's sampling.
-  double cut_spacing = 0;
+  // The median edge of the initial operation part (of the whole mesh when the region follows
+  // the blade): ~cut paths are resampled at kPathSpacingFraction of it whatever the caller's
+  // sampling (docs/DESIGN.md (cutting)), and a following region's waiting sweeps are grouped
+  // up to it.
+  double median_edge = 0;
 
   std::unique_ptr<LinearSolver> make_solver() {
     backend = "cpu";
@@ -158,16 +160,16 @@ struct Simulation::Impl {
     std::vector<std::uint8_t> locked(static_cast<size_t>(model->mesh().num_nodes()), 0);
     for (int i : p.interface) locked[static_cast<size_t>(i)] = 1;
     cut_state = make_cut_state(model->mesh_for_cutting(), locked, p.operation_tet);
-    cut_spacing = median_operation_edge(scene.mesh, p.operation_tet);
+    median_edge = median_operation_edge(scene.mesh, p.operation_tet);
     anchored = model->fixed_nodes();
     if (scene.operation_region.follows_blade()) {
       // The ball goes anywhere: the blade is sampled at half the median edge of the whole
       // mesh. A moved region condenses tissue the blade has cut, so a piece is anchored by its
       // fixed (or held) nodes only, never by interface nodes.
-      cut_spacing =
+      median_edge =
           median_operation_edge(scene.mesh, std::vector<std::uint8_t>(scene.mesh.tets.size(), 1));
       follower = std::make_unique<RegionFollower>(scene.operation_region.sphere, *model,
-                                                  0.5 * cut_spacing);
+                                                  0.5 * median_edge);
     } else {
       // A fixed region's part 2 is uncut and every piece of it reaches an interface or fixed
       // node: interface nodes anchor.
@@ -740,7 +742,7 @@ struct Simulation::Impl {
     const double length = scene.scalpel.blade_length;
     std::vector<BladePose> run = {pending_sweeps.front().from, pending_sweeps.front().to};
     double travel = blade_travel(run[0], run[1], length);
-    for (size_t k = 1; k < pending_sweeps.size() && travel <= cut_spacing; ++k) {
+    for (size_t k = 1; k < pending_sweeps.size() && travel <= median_edge; ++k) {
       const Sweep& next = pending_sweeps[k];
       const BladePose& end = run.back();
       if (next.from.position != end.position ||
@@ -752,7 +754,7 @@ struct Simulation::Impl {
       travel += blade_travel(next.from, next.to, length);
       run.push_back(next.to);
     }
-    return std::max<size_t>(1, straight_sweep_steps(run, length, 0.25e-3, cut_spacing));
+    return std::max<size_t>(1, straight_sweep_steps(run, length, 0.25e-3, median_edge));
   }
 
   // A blade near tissue the region does not hold clear of its interface: a move around it.
@@ -1050,7 +1052,7 @@ CutOutcome Simulation::finish_path_cut(const PathCut& cut) const {
 }
 
 void Simulation::reset() { impl_->start(); }
-double Simulation::cut_path_spacing() const { return kPathSpacingFraction * impl_->cut_spacing; }
+double Simulation::cut_path_spacing() const { return kPathSpacingFraction * impl_->median_edge; }
 void Simulation::set_cutting_enabled(bool enabled) { impl_->cutting_enabled = enabled; }
 bool Simulation::cutting_enabled() const { return impl_->cutting_enabled; }
 void Simulation::set_cut_pressure(double newtons) { impl_->scene.scalpel.cut_pressure = newtons; }
