@@ -8,7 +8,9 @@ strokes (docs/DESIGN.md section 12, "How much of the matrix is where the strokes
 mesh"). This runs the matrix unshifted and with every stroke moved (STC_FIDELITY_SHIFT) by
 +-D mm along its path and across its blade plane, and prints per position and in all: strokes
 within the two-sided Hausdorff tolerance, the summed excess over it, the least opening on the
-lesser side and the least share of the sweep covered by open faces.
+lesser side, the least share of the sweep covered by open faces, and the least share walled on
+the lesser side (swept points whose line along the blade normal meets an open face of that side
+within the tolerance) with how many strokes are walled under 90 %.
 
 usage: scripts/fidelity_positions.py BINARY [--shift D] [--guard DEG]
   BINARY: the core unit tests (build-core/tissue_core_unit, or devel/lib/.../tissue_core_unit)
@@ -25,6 +27,7 @@ LINE = re.compile(
     r"FIDELITY (\S+) (.*?): swept ([\d.e+-]+) cm2, opened ([\d.e+-]+) / ([\d.e+-]+) cm2 "
     r"\(([\d.e+-]+) % the lesser side; ([\d.e+-]+) % of the swept area.*?"
     r"; ([\d.e+-]+) x tolerance; faces ([\d.e+-]+) x\)")
+WALLED = re.compile(r", walled ([\d.e+-]+) / ([\d.e+-]+) %")
 GROUPS = ["CutFidelity.ThighMatrix:CutFidelity.*Coarse*",
           "CutFidelity.Liver2Fine:CutFidelity.LiverBoundaryFine"]
 
@@ -41,8 +44,10 @@ def run(binary, shift, guard):
         for line in out.splitlines():
             m = LINE.match(line)
             if m and "path border" not in line:
+                w = WALLED.search(line)
+                walled = min(float(w.group(1)), float(w.group(2))) if w else float("nan")
                 rows.append((m.group(1), m.group(2), float(m.group(6)), float(m.group(7)),
-                             float(m.group(8))))
+                             float(m.group(8)), walled))
     return rows
 
 
@@ -66,7 +71,7 @@ def main(argv):
     total_within = total_rows = 0
     total_excess = 0.0
     print(f"{'shift (along, aside) mm':>24} {'within':>8} {'excess':>8} {'least opened %':>15}"
-          f" {'least covered %':>16}")
+          f" {'least covered %':>16} {'least walled %':>15} {'walled < 90 %':>14}")
     for along, aside in positions:
         rows = run(binary, f"{along} {aside}", guard)
         if len(rows) != 40:
@@ -79,7 +84,8 @@ def main(argv):
         total_rows += len(rows)
         total_excess += excess
         print(f"{f'({along:+g}, {aside:+g})':>24} {within:>5}/{len(rows)} {excess:8.2f}"
-              f" {min(r[2] for r in rows):15.1f} {min(r[3] for r in rows):16.1f}")
+              f" {min(r[2] for r in rows):15.1f} {min(r[3] for r in rows):16.1f}"
+              f" {min(r[5] for r in rows):15.1f} {sum(1 for r in rows if r[5] < 90):14d}")
     print(f"{'all positions':>24} {total_within:>4}/{total_rows} {total_excess:8.2f}")
     return 0
 

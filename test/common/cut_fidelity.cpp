@@ -180,6 +180,25 @@ CutFidelity measure_cut_fidelity(const MeasuredRegion& region, const TetMesh& me
       }
       if (!std::isfinite(best)) best = 2.0;  // nothing opened near: 2 m stands for "no face"
       if (best <= tolerance_at(h)) out.covered_area += weight, out.covered_by_triangle[k] += weight;
+      // Walled: the line through p along the blade normal meets an open face of each side
+      // within the tolerance (faces within it of p are among those searched above).
+      std::vector<int> near;
+      const double reach = tolerance_at(h);
+      face_tree.overlapping(Box3(p - Vec3::Constant(reach), p + Vec3::Constant(reach)), near);
+      std::array<bool, 2> walled{};
+      for (int j : near) {
+        const Face& f = faces[static_cast<size_t>(j)];
+        const double c = f.normal.dot(sweep_normal[k]);
+        if (std::abs(c) < 1e-6 || walled[c > 0 ? 1 : 0]) continue;
+        const double along = f.normal.dot(f.x[0] - p) / c;  // p + along n lies on f's plane
+        if (std::abs(along) > reach) continue;
+        const Vec3 q = p + along * sweep_normal[k];
+        const Vec3 n = (f.x[1] - f.x[0]).cross(f.x[2] - f.x[0]);
+        const double u = n.dot((f.x[1] - q).cross(f.x[2] - q)),
+                     v = n.dot((f.x[2] - q).cross(f.x[0] - q));
+        if (u >= 0 && v >= 0 && n.squaredNorm() - u - v >= 0) walled[c > 0 ? 1 : 0] = true;
+      }
+      for (int side = 0; side < 2; ++side) out.walled_area[side] += walled[side] ? weight : 0.0;
       if (best > out.sweep_to_faces) out.sweep_to_faces = best, out.worst_swept_point = p;
       out.hausdorff_over_tolerance = std::max(out.hausdorff_over_tolerance, best / tolerance_at(h));
     }

@@ -61,6 +61,10 @@ struct CutFidelity {
   // Per sweep triangle (same order): its swept area in the region and how much of that is
   // within tolerance of an open face (m^2; the sums are swept_area and covered_area).
   std::vector<double> swept_by_triangle, covered_by_triangle;
+  // Per side (as opened_area): the swept area whose line along the blade normal meets an open
+  // face of that side within the tolerance (m^2) - how much of the sweep each wall covers,
+  // whatever the faces' own area (one face may be larger than the region, or lean across it).
+  std::array<double, 2> walled_area{};
   // min(opened_area) / swept_area (0 when nothing was swept).
   double opening() const {
     return swept_area > 0 ? std::min(opened_area[0], opened_area[1]) / swept_area : 0;

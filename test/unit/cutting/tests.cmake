@@ -9,6 +9,7 @@ list(APPEND TISSUE_UNIT_TESTS
   test/unit/cutting/test_cut_state.cpp
   test/unit/cutting/test_cut_sweep_box.cpp
   test/unit/cutting/test_earlier_triangles.cpp
+  test/unit/cutting/test_fidelity_measure.cpp
   test/unit/cutting/test_tet_flips.cpp
   test/unit/cutting/test_tet_grid.cpp
   test/unit/cutting/test_vertex_insertion.cpp
