@@ -468,20 +468,30 @@ CutResult finish_stroke(TetMesh& mesh, CutState& state, const CutOptions& option
   }
   CutResult result =
       cut_triangles(mesh, state, reached, options, state.last_sweep, front, 1.0, nullptr, stops);
+  // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
+  const auto open_marks = [&](const std::vector<int>& tets) {
+    const long marked_before = count_marked_face_sides(mesh);
+    const size_t changed_before = result.changed_tets.size();
+    if (open_closed_marks(mesh, state, tets, options, result) > 0)
+      settle(mesh, state, result, changed_before, marked_before);
+  };
+  if (options.open_closed_marks) open_marks(state.stroke_tets);
   // Where the tip's path meets the front the opened surface may stop an element short of the
-  // tip (tip_corner.hpp).
+  // tip (tip_corner.hpp): filled once the marks have opened what they can, its own marks then
+  // opened as the others were.
   if (options.fill_tip_corner) {
     const long marked_before = count_marked_face_sides(mesh);
     const size_t changed_before = result.changed_tets.size();
-    if (fill_tip_corner(mesh, state, state.last_sweep_end[0], band, options, result) >= 0)
+    if (fill_tip_corner(mesh, state, state.last_sweep_end[0], band, options, result) >= 0) {
       settle(mesh, state, result, changed_before, marked_before);
+      if (options.open_closed_marks) {
+        std::vector<int> tets = state.stroke_tets;
+        tets.insert(tets.end(), result.changed_tets.begin() + static_cast<long>(changed_before),
+                    result.changed_tets.end());
+        open_marks(tets);
+      }
+    }
   }
-  if (!options.open_closed_marks) return result;
-  // What only border corners hold shut is opened now: nothing later will (closed_marks.hpp).
-  const long marked_before = count_marked_face_sides(mesh);
-  const size_t changed_before = result.changed_tets.size();
-  if (open_closed_marks(mesh, state, state.stroke_tets, options, result) > 0)
-    settle(mesh, state, result, changed_before, marked_before);
   return result;
 }
 

@@ -400,6 +400,13 @@ int apply_insertion(TetMesh& mesh, CutState& state, const VertexInsertion& inser
   return node;
 }
 
+void apply_star(TetMesh& mesh, CutState& state, const VertexInsertion& star, CutResult& result) {
+  Flip flip = as_flip(star);
+  flip.insert = false;  // its tets hold the apex, a node of the mesh
+  const std::vector<int> changed = apply(mesh, state, flip, result);
+  result.changed_tets.insert(result.changed_tets.end(), changed.begin(), changed.end());
+}
+
 FlipCounts flip_thin_tets(TetMesh& mesh, CutState& state, const CutOptions& options,
                           const std::vector<int>& tets, CutResult& result) {
   FlipCounts flips;

@@ -36,6 +36,11 @@ struct FlipCounts {
 int apply_insertion(TetMesh& mesh, CutState& state, const VertexInsertion& insertion,
                     CutResult& result, bool shape);
 
+// Replaces a star-from-a-corner's cavity by its tets (star_from_corner, vertex_insertion.hpp):
+// no node is added; the cavity's boundary faces keep their cut marks. The changed and appended
+// tets go to result.changed_tets.
+void apply_star(TetMesh& mesh, CutState& state, const VertexInsertion& star, CutResult& result);
+
 // Flips that raise the smallest dihedral angle of `tets` below CutOptions::smooth_below_deg
 // (and of the tets the flips make), each by more than 0.05 deg over the tets it replaces and
 // keeping every new tet above twice CutOptions::min_volume_fraction of its size class; where no

@@ -21,6 +21,8 @@ constexpr int kPlaceRings = 4;
 constexpr int kPlaceAngles = 8;
 // How many tets the cavity may grow by when a new tet is too thin.
 constexpr int kMaxGrowth = 4;
+// How many of the cut's nodes nearest the tip are tried as the corner's apex.
+constexpr size_t kMaxApexes = 4;
 
 bool holds_point(const TetMesh& mesh, int t, const Vec3& p) {
   const Tet& k = mesh.tets[static_cast<size_t>(t)];
@@ -73,11 +75,13 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
   const double reach = 4 * margin, snap = options.snap_tolerance * reach;
   const std::vector<int> near =
       state.grid.query(mesh, tip - Vec3::Constant(reach), tip + Vec3::Constant(reach));
-  // The marked faces near the tip: covered already (within a margin), or their edges facing it
-  // - of opened walls only: a closed mark may still open at the stroke's end (closed_marks.hpp),
-  // and a triangle hung on it would be one more whose corners all lie on the border (on the
-  // fine liver2's tilted straight 3 mm stroke the marks at the tip then all stayed shut).
-  // edge -> every mark on it is opened and lies away from the tip
+  // The marked faces near the tip: covered already (an opened one within a margin), or their
+  // edges facing it. The stroke's end has opened what it can before (finish_stroke), so a mark
+  // still closed stays so: it covers nothing, and a triangle may hang on it. (Up to stop 55 the
+  // fill came first and only opened walls counted: hung on a mark still to open, the triangle
+  // stacked marks whose corners all lie on the border, and on the fine liver2's tilted straight
+  // 3 mm stroke every mark at the tip stayed shut.)
+  // edge -> every mark on it lies away from the tip
   std::map<std::pair<int, int>, bool> facing;
   for (int t : near)
     for (int f = 0; f < 4; ++f) {
@@ -86,15 +90,15 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
       Vec3 w;
       const Vec3 closest = closest_point_on_triangle(tip, mesh.nodes[key[0]], mesh.nodes[key[1]],
                                                      mesh.nodes[key[2]], w);
-      if ((closest - tip).norm() <= margin) return -1;
+      const bool opened = neighbour_across(mesh, state, t, f).first < 0;
+      if (opened && (closest - tip).norm() <= margin) return -1;
       for (int e = 0; e < 3; ++e) {
         const int a = std::min(key[e], key[(e + 1) % 3]), b = std::max(key[e], key[(e + 1) % 3]);
         const Vec3 &xa = mesh.nodes[a], &xb = mesh.nodes[b], &xc = mesh.nodes[key[(e + 2) % 3]];
         const double tip_side = normal.dot((xb - xa).cross(tip - xa)),
                      mark_side = normal.dot((xb - xa).cross(xc - xa));
-        const bool opened = neighbour_across(mesh, state, t, f).first < 0;
         auto it = facing.emplace(std::make_pair(a, b), true).first;
-        it->second = it->second && opened && tip_side * mark_side < 0;
+        it->second = it->second && tip_side * mark_side < 0;
       }
     }
   // The corner's triangles: each border edge facing the tip, on the plane (within the snap
@@ -135,8 +139,8 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
   // The cavity: the tets the fan's triangles pass through. The whole fan, else its triangles
   // one by one, nearest first (a boundary face of the cavity may lie on the plane, the node
   // flat against it).
-  const auto insert_for = [&](const std::vector<CornerTriangle>& triangles,
-                              VertexInsertion& insertion) {
+  // The tets the triangles from `from` to the fan's edges pass through.
+  const auto cavity_of = [&](const std::vector<CornerTriangle>& triangles, const Vec3& from) {
     std::vector<int> cavity;
     for (const CornerTriangle& c : triangles) {
       const Vec3 &xa = mesh.nodes[c.a], &xb = mesh.nodes[c.b];
@@ -145,17 +149,26 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
           for (double shift : {1.0 / 3, 2.0 / 3}) {
             if (shift > 0.5 && i + j + 1 >= kSamplesPerSide) continue;
             const Vec3 p =
-                tip + ((i + shift) * (xa - tip) + (j + shift) * (xb - tip)) / kSamplesPerSide;
+                from + ((i + shift) * (xa - from) + (j + shift) * (xb - from)) / kSamplesPerSide;
             for (int t : state.grid.query(mesh, p, p))
               if (holds_point(mesh, t, p)) cavity.push_back(t);
           }
     }
+    return cavity;
+  };
+  const auto edges_of = [](const std::vector<CornerTriangle>& triangles) {
     std::vector<std::pair<int, int>> edges;
     for (const CornerTriangle& c : triangles) edges.emplace_back(c.a, c.b);
+    return edges;
+  };
+  const auto insert_for = [&](const std::vector<CornerTriangle>& triangles,
+                              VertexInsertion& insertion) {
+    const std::vector<std::pair<int, int>> edges = edges_of(triangles);
     // Every triangle must be a face of the new tets (its border edge on the cavity's
     // boundary): else the node would not fill the corner.
-    return vertex_insertion_growing(mesh, state, cavity, places, 2 * options.min_volume_fraction,
-                                    options.split_min_dihedral_deg, edges, kMaxGrowth, insertion) &&
+    return vertex_insertion_growing(mesh, state, cavity_of(triangles, tip), places,
+                                    2 * options.min_volume_fraction, options.split_min_dihedral_deg,
+                                    edges, kMaxGrowth, insertion) &&
            joins_edges(insertion, edges);
   };
   std::vector<std::vector<CornerTriangle>> tries = {fan};
@@ -165,9 +178,48 @@ int fill_tip_corner(TetMesh& mesh, CutState& state, const Vec3& tip,
   auto chosen = std::find_if(tries.begin(), tries.end(), [&](const auto& triangles) {
     return insert_for(triangles, insertion);
   });
-  if (chosen == tries.end()) return -1;
-  fan = *chosen;
-  const int node = apply_insertion(mesh, state, insertion, result, false);
+  // Else a node of the cut already near the tip (eq. (19d')): a node there makes tets too thin
+  // when one lies there already, short of the fan's edges by a tet that no face on the plane
+  // crosses (the thigh's curved vertical 0.2 mm stroke: a node 0.6 mm from the tip, its nearest
+  // open face 5 mm away). The tets the triangles from it pass through are retriangulated as its
+  // star where that keeps the guards; the nearest such node first, the whole fan first.
+  const auto from_node = [&]() {
+    std::vector<std::pair<double, int>> apexes;
+    for (int t : near)
+      for (int w : mesh.tets[static_cast<size_t>(t)]) {
+        const Vec3& x = mesh.nodes[static_cast<size_t>(w)];
+        if ((x - tip).norm() <= margin && is_on_stroke(state, w) &&
+            std::abs(normal.dot(x - tip)) <= snap)
+          apexes.emplace_back((x - tip).norm(), w);
+      }
+    std::sort(apexes.begin(), apexes.end());
+    apexes.erase(std::unique(apexes.begin(), apexes.end()), apexes.end());
+    for (size_t k = 0; k < apexes.size() && k < kMaxApexes; ++k) {
+      const int apex = apexes[k].second;
+      for (const auto& triangles : tries) {
+        if (std::any_of(triangles.begin(), triangles.end(),
+                        [&](const CornerTriangle& c) { return c.a == apex || c.b == apex; }))
+          continue;
+        if (star_from_corner(mesh, state, cavity_of(triangles, mesh.nodes[apex]), apex,
+                             2 * options.min_volume_fraction, options.split_min_dihedral_deg,
+                             insertion) &&
+            joins_edges_at(insertion, apex, edges_of(triangles))) {
+          apply_star(mesh, state, insertion, result);
+          fan = triangles;
+          return apex;
+        }
+      }
+    }
+    return -1;
+  };
+  int node = -1;
+  if (chosen != tries.end()) {
+    fan = *chosen;
+    node = apply_insertion(mesh, state, insertion, result, false);
+  } else if (options.tip_corner_from_node) {
+    node = from_node();
+  }
+  if (node < 0) return -1;
   set_on_stroke(state, node);
   // Its corners all lie on the cut's border, so each triangle marked stays closed until the
   // stroke's end gives it a corner inside the cut (closed_marks.hpp). (A node inside the

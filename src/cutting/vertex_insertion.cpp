@@ -262,14 +262,44 @@ bool vertex_insertion_growing(const TetMesh& mesh, const CutState& state, std::v
   return false;
 }
 
-bool joins_edges(const VertexInsertion& insertion, const std::vector<std::pair<int, int>>& edges) {
+bool star_from_corner(const TetMesh& mesh, const CutState& state, std::vector<int> cavity, int apex,
+                      double guard, double min_angle_deg, VertexInsertion& insertion) {
+  double volume = 0, flattest = 0, shortest = 0;
+  if (!describe_cavity(mesh, state, std::move(cavity), insertion, volume, flattest, shortest))
+    return false;
+  // The apex's own boundary faces stay faces (of the tets joining it to the faces beside them);
+  // the others are joined to it. The apex must be a corner of the cavity: a star from a point
+  // inside would be an insertion.
+  const size_t faces = insertion.tets.size();
+  insertion.tets.erase(
+      std::remove_if(insertion.tets.begin(), insertion.tets.end(),
+                     [&](const Tet& k) { return std::count(k.begin(), k.end(), apex) > 0; }),
+      insertion.tets.end());
+  if (insertion.tets.size() == faces || insertion.tets.size() < insertion.cavity.size())
+    return false;
+  const Vec3& at = mesh.nodes[static_cast<size_t>(apex)];
+  insertion.after = quality_at(mesh, insertion.tets, at, guard * insertion.size_class);
+  if (!(insertion.after >= min_angle_deg) || !(insertion.after > 0)) return false;
+  if (!tiles_and_locate(mesh, at, volume, insertion)) return false;
+  for (Tet& k : insertion.tets)
+    for (int& v : k)
+      if (v == kInsertedNode) v = apex;
+  return true;
+}
+
+bool joins_edges_at(const VertexInsertion& insertion, int apex,
+                    const std::vector<std::pair<int, int>>& edges) {
   return std::all_of(edges.begin(), edges.end(), [&](const std::pair<int, int>& e) {
     for (const Tet& k : insertion.tets)
-      if (std::count(k.begin(), k.end(), kInsertedNode) &&
-          std::count(k.begin(), k.end(), e.first) && std::count(k.begin(), k.end(), e.second))
+      if (std::count(k.begin(), k.end(), apex) && std::count(k.begin(), k.end(), e.first) &&
+          std::count(k.begin(), k.end(), e.second))
         return true;
     return false;
   });
+}
+
+bool joins_edges(const VertexInsertion& insertion, const std::vector<std::pair<int, int>>& edges) {
+  return joins_edges_at(insertion, kInsertedNode, edges);
 }
 
 std::vector<std::vector<int>> insertion_cavities(const TetMesh& mesh, const CutState& state,

@@ -57,8 +57,21 @@ bool vertex_insertion_growing(const TetMesh& mesh, const CutState& state, std::v
                               const std::vector<std::pair<int, int>>& keep, int max_growth,
                               VertexInsertion& insertion);
 
+// The cavity retriangulated as the star of one of its corners, `apex` (a node of the cut near
+// where the blade's tip stopped, tip_corner.hpp, where a new node there makes tets too thin):
+// every boundary face not on the apex joined to it, by the rules of vertex_insertion_at - every
+// new tet above `guard` of the size class and its smallest dihedral angle at least
+// min_angle_deg, tiling the cavity - and at least as many new tets as the cavity has (they
+// take its indices, the rest appended). No node is added: insertion.tets hold the apex itself
+// and insertion.point is where it lies.
+bool star_from_corner(const TetMesh& mesh, const CutState& state, std::vector<int> cavity, int apex,
+                      double guard, double min_angle_deg, VertexInsertion& insertion);
+
 // Does the insertion make a face (new node, a, b) for every edge (a, b)?
 bool joins_edges(const VertexInsertion& insertion, const std::vector<std::pair<int, int>>& edges);
+// The same for a star from a corner: a face (apex, a, b) for every edge (a, b).
+bool joins_edges_at(const VertexInsertion& insertion, int apex,
+                    const std::vector<std::pair<int, int>>& edges);
 
 // The cavities tried for tet t: t with its neighbours across its faces on no cut, and the ring
 // of each of its edges (3 to 10 tets).

@@ -189,6 +189,11 @@ struct CutOptions {
   // 1.52 -> 1.12 x the Hausdorff tolerance, issue 9's 200 shifted strokes' summed excess over it
   // 14.64 -> 14.24, none worse).
   bool fill_tip_corner = true;
+  // Where a new node at the tip makes tets too thin, a node of the cut within a front margin of
+  // the tip fills the corner instead: the tets the triangles from it pass through are
+  // retriangulated as its star (cutting/tip_corner.hpp; docs/DESIGN.md section 8, "The tip's
+  // corner", eq. (19d')).
+  bool tip_corner_from_node = true;
   // A closed mark at a stroke's end whose edge shared with another mark the guards keep whole is
   // split at its centre instead (cutting/closed_marks.hpp).
   bool open_marks_at_centre = true;

@@ -449,6 +449,37 @@ TEST(CutFidelity, TheTipsCornerFillsAtAStrokesEnd) {
   EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
 }
 
+// The tip's corner filled once the stroke's end has opened what it can, hung on any mark facing
+// the tip (stop 56; before, the fill came first and only opened walls counted). The thigh's
+// curved 45-degree 0.2 mm stroke moved 0.5 mm on and 0.5 mm aside: the opened surface stopped
+// 5 mm short of the tip (1.73 x the Hausdorff tolerance, as without the fill), 0.92 x now.
+TEST(CutFidelity, TheTipsCornerFillsAfterTheMarksOpen) {
+  const OnAndOff r = on_and_off(
+      "thigh", 45, 0.2e-3, true, [](CutOptions& o) { o.fill_tip_corner = false; },
+      "corner filled last", "corner not filled", 0.5, -0.5);
+  EXPECT_LE(r.on.f.hausdorff_over_tolerance, 1.0) << r.on.line;
+  EXPECT_GT(r.off.f.hausdorff_over_tolerance, 1.3) << r.off.line;
+  EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
+}
+
+// CutOptions::tip_corner_from_node (cutting/tip_corner.hpp, eq. (19d')): where a new node at
+// the tip would make tets too thin, a node of the cut within a front margin of it becomes the
+// corner, the tets the triangle from it passes through retriangulated as its star. The thigh's
+// curved vertical 0.2 mm stroke moved 0.5 mm back and 0.5 mm aside: the opened surface short of
+// the tip (1.38 x the Hausdorff tolerance) without it, 0.86 x with it. The star's tets keep the 5
+// deg guard.
+TEST(CutFidelity, TheTipsCornerFillsFromANodeOfTheCut) {
+  const OnAndOff r = on_and_off(
+      "thigh", 0, 0.2e-3, true, [](CutOptions& o) { o.tip_corner_from_node = false; },
+      "corner from a node", "corner from no node", -0.5, -0.5);
+  EXPECT_LE(r.on.f.hausdorff_over_tolerance, 1.0) << r.on.line;
+  EXPECT_GT(r.off.f.hausdorff_over_tolerance, 1.2) << r.off.line;
+  EXPECT_GE(r.on.min_dihedral,
+            std::min(CutOptions{}.split_min_dihedral_deg, r.on.min_dihedral_before) - 1e-6)
+      << r.on.line;
+  EXPECT_GE(r.on.f.opening(), 0.9) << r.on.line;
+}
+
 // CutOptions::open_marks_at_input_scale (cutting/closed_marks.hpp): a closed mark split small
 // near the tip's path counts as along the blade's sweep at the scale of the input tet it came
 // from, so the stroke's end opens it. Over issue 9's 200 shifted strokes 149 -> 156 within the

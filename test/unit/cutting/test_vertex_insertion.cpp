@@ -5,11 +5,13 @@
 // that the cavity would lose, forbids it.
 #include "common/cut_fidelity_scenes.hpp"
 #include "common/cut_measures.hpp"
+#include "common/cut_state_checks.hpp"
 #include "cutting/cut_state.hpp"
 #include "cutting/tet_flips.hpp"
 #include "cutting/triangle_cut.hpp"
 #include "cutting/vertex_insertion.hpp"
 #include "soft_tissue_cutting/cutting/invariants.hpp"
+#include "soft_tissue_cutting/generators/thigh.hpp"
 #include "soft_tissue_cutting/mesh/boundary_surface.hpp"
 #include "soft_tissue_cutting/mesh/quality.hpp"
 
@@ -107,16 +109,7 @@ TEST(VertexInsertion, WhereFlipsStopNodesInsideRemoveMoreThinTets) {
     EXPECT_LT((at - inserted.mesh.nodes[static_cast<size_t>(node.index)]).norm(), 1e-12);
   }
   // The cut state follows: every tet in its corners' stars, and only there.
-  ASSERT_EQ(inserted.state.node_tets.size(), static_cast<size_t>(inserted.mesh.num_nodes()));
-  ASSERT_EQ(inserted.state.locked.size(), static_cast<size_t>(inserted.mesh.num_nodes()));
-  size_t incidences = 0;
-  for (int v = 0; v < inserted.mesh.num_nodes(); ++v)
-    for (int t : inserted.state.node_tets[static_cast<size_t>(v)]) {
-      const Tet& e = inserted.mesh.tets[static_cast<size_t>(t)];
-      EXPECT_NE(std::find(e.begin(), e.end(), v), e.end()) << "node " << v << ", tet " << t;
-      ++incidences;
-    }
-  EXPECT_EQ(incidences, 4 * inserted.mesh.tets.size());
+  EXPECT_EQ(test::stars_mismatch(inserted.mesh, inserted.state), "");
 }
 
 TEST(VertexInsertion, ACutFaceInsideTheCavityForbidsIt) {
@@ -163,6 +156,98 @@ TEST(VertexInsertion, AStarWithANodeInsideIsNotACavity) {
   CutState state = make_cut_state(mesh, {}, {});
   VertexInsertion insertion;
   EXPECT_FALSE(vertex_insertion(mesh, state, {0, 1, 2, 3}, 0.02, insertion));
+}
+
+// star_from_corner (tip_corner.hpp's fill from a node of the cut): a cavity retriangulated as
+// the star of one of its corners. A unit cube's six Kuhn tets all hold its main diagonal, so
+// the star of its corner (0, 0, 0) is valid (every far face seen at a positive volume); the
+// corner (1, 0, 0) lies in the plane of a triangle it is not on (the face y = 0 is split along
+// (0, 0, 0)-(1, 0, 1)), so its star would hold a flat tet.
+TEST(StarFromCorner, AConvexCavityIsTheStarOfACornerThatSeesEveryFarFace) {
+  GeneratorParams g;
+  g.size = Vec3(0.01, 0.01, 0.01);
+  g.cells = {1, 1, 1};
+  TetMesh cube = make_box_mesh(g);
+  CutState state = make_cut_state(cube, {}, {});
+  const auto at = [&](const Vec3& x) {
+    for (int v = 0; v < cube.num_nodes(); ++v)
+      if ((cube.nodes[static_cast<size_t>(v)] - x).norm() < 1e-12) return v;
+    return -1;
+  };
+  const int origin = at(Vec3::Zero()), beside = at(Vec3(0.01, 0, 0));
+  ASSERT_GE(origin, 0);
+  ASSERT_GE(beside, 0);
+  VertexInsertion star;
+  ASSERT_TRUE(star_from_corner(cube, state, all_tets(cube), origin, 0.02, 5.0, star));
+  EXPECT_EQ(star.tets.size(), 6u);  // the three far faces' two triangles each
+  double volume = 0;
+  for (const Tet& k : star.tets) {
+    EXPECT_EQ(std::count(k.begin(), k.end(), origin), 1);
+    volume += signed_volume(cube.nodes[k[0]], cube.nodes[k[1]], cube.nodes[k[2]], cube.nodes[k[3]]);
+  }
+  EXPECT_NEAR(volume, 1e-6, 1e-18);
+  EXPECT_GE(star.after, 5.0);
+  EXPECT_FALSE(star_from_corner(cube, state, all_tets(cube), beside, 0.02, 0.0, star));
+  // Not a corner of the cavity: a star from a node elsewhere is not one.
+  TetMesh two = cube;
+  two.nodes.push_back(Vec3(0.02, 0.02, 0.02));
+  CutState two_state = make_cut_state(two, {}, {});
+  EXPECT_FALSE(
+      star_from_corner(two, two_state, all_tets(two), two.num_nodes() - 1, 0.02, 0.0, star));
+}
+
+// Applied on a stroked liver (apply_star, tet_flips.hpp): an edge's ring retriangulated as the
+// star of a corner of it keeps the boundary, the cut faces, the volume and the node count, and
+// the cut state follows.
+TEST(StarFromCorner, AppliedItKeepsTheBoundaryTheCutAndTheVolume) {
+  StrokedLiver s = stroked_liver();
+  const auto surface = boundary_faces(s.mesh);
+  const auto marked_sides = [](const TetMesh& mesh) {
+    int sides = 0;
+    for (std::uint8_t bits : mesh.cut_faces) sides += __builtin_popcount(bits);
+    return sides;
+  };
+  const int nodes = s.mesh.num_nodes(), marked = marked_sides(s.mesh);
+  VertexInsertion star;
+  int apex = -1, tried = 0;
+  for (int t = 0; t < s.mesh.num_tets() && apex < 0; ++t)
+    for (const std::vector<int>& c : insertion_cavities(s.mesh, s.state, t)) {
+      std::set<int> corners;
+      for (int k : c)
+        corners.insert(s.mesh.tets[static_cast<size_t>(k)].begin(),
+                       s.mesh.tets[static_cast<size_t>(k)].end());
+      for (int v : corners) {
+        ++tried;
+        if (star_from_corner(s.mesh, s.state, c, v, 0.02, 5.0, star)) {
+          apex = v;
+          break;
+        }
+      }
+      if (apex >= 0) break;
+    }
+  ASSERT_GE(apex, 0) << tried << " stars tried";
+  const size_t cavity = star.cavity.size();
+  CutResult result;
+  apply_star(s.mesh, s.state, star, result);
+  EXPECT_EQ(s.mesh.num_nodes(), nodes);
+  EXPECT_TRUE(result.new_nodes.empty());
+  EXPECT_EQ(result.changed_tets.size(), star.tets.size());
+  EXPECT_GE(star.tets.size(), cavity);
+  EXPECT_EQ(boundary_faces(s.mesh), surface);
+  EXPECT_EQ(marked_sides(s.mesh), marked);
+  EXPECT_NEAR(total_volume(s.mesh), s.volume, 1e-12 * s.volume);
+  for (int t : result.changed_tets) {
+    const Tet& k = s.mesh.tets[static_cast<size_t>(t)];
+    EXPECT_EQ(std::count(k.begin(), k.end(), apex), 1) << t;
+    EXPECT_GE(smallest_dihedral_deg(s.mesh.nodes[k[0]], s.mesh.nodes[k[1]], s.mesh.nodes[k[2]],
+                                    s.mesh.nodes[k[3]]),
+              5.0 - 1e-9);
+  }
+  InvariantLimits limits;
+  limits.initial_volume = s.volume;
+  const auto violated = check_cut_invariants(s.mesh, s.state.origin_volume, limits);
+  EXPECT_TRUE(violated.empty()) << violated.front();
+  EXPECT_EQ(test::stars_mismatch(s.mesh, s.state), "");
 }
 
 }  // namespace
