@@ -432,8 +432,8 @@ TEST(CutFidelity, CurvedStrokesConformAlongTheTipsPath) {
 // 3.06 mm (1.12 x; the last third of the triangle stays shut where the shape guard refuses its
 // split). The new tets keep the 5 deg guard.
 // Since stop 55 the tip's border follows the path the tip took (CutOptions::tip_border_on_path)
-// and no stroke of issue 9's 200 shifted ones fills a corner (the same cut with and without):
-// measured here with the border on the band's segment, where the corner still opens short.
+// and the corner opens short on fewer strokes: measured here with the border on the band's
+// segment, where this one still does (stop 56 fills corners on others, below).
 TEST(CutFidelity, TheTipsCornerFillsAtAStrokesEnd) {
   const OnAndOff r = on_and_off(
       "thigh", 45, 3e-3, true, [](CutOptions& o) { o.fill_tip_corner = false; },
